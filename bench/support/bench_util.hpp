@@ -1,0 +1,228 @@
+// Helpers every benchmark uses: command-line options, median-of-repeats timing, the machine's
+// description, an aligned text table and the same table as a JSON document.
+//
+// Conventions: times are wall-clock seconds from std::chrono::steady_clock; a benchmark reports
+// the median over `repeats` runs (the machines are shared and noisy: the median ignores the
+// odd slow run) and compares thread counts measured in the same process run.
+#pragma once
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <utility>
+#include <vector>
+
+namespace ulc_bench {
+
+struct Options {
+  bool json = false;  ///< --json: print a JSON document instead of the table
+  int repeats = 5;    ///< --repeats N (at least 1)
+};
+
+/// Parses --json and --repeats N; prints usage and exits on anything else (bench code only).
+inline Options parse_options(int argc, char** argv, const char* description) {
+  Options options;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--json") {
+      options.json = true;
+    } else if (arg == "--repeats" && i + 1 < argc) {
+      options.repeats = std::max(1, std::atoi(argv[++i]));
+    } else {
+      std::cerr << argv[0] << ": " << description << "\n"
+                << "usage: " << argv[0] << " [--json] [--repeats N]\n";
+      std::exit(arg == "--help" || arg == "-h" ? 0 : 2);
+    }
+  }
+  return options;
+}
+
+struct Machine {
+  unsigned threads = 0;  ///< std::thread::hardware_concurrency(), what nproc reports
+  std::string cpu;       ///< "model name" from /proc/cpuinfo, or "unknown"
+  std::string load;      ///< 1, 5 and 15 minute load averages from /proc/loadavg (shared hosts)
+};
+
+inline Machine machine() {
+  Machine m;
+  m.threads = std::thread::hardware_concurrency();
+  m.cpu = "unknown";
+  std::ifstream cpuinfo("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(cpuinfo, line)) {
+    if (line.rfind("model name", 0) == 0) {
+      const auto colon = line.find(':');
+      if (colon != std::string::npos) m.cpu = line.substr(line.find_first_not_of(" \t", colon + 1));
+      break;
+    }
+  }
+  std::ifstream loadavg("/proc/loadavg");
+  std::string one, five, fifteen;
+  if (loadavg >> one >> five >> fifteen) m.load = one + " " + five + " " + fifteen;
+  return m;
+}
+
+/// Wall time of one call of f, in seconds.
+template <class F>
+double seconds_of(F&& f) {
+  const auto start = std::chrono::steady_clock::now();
+  f();
+  const auto stop = std::chrono::steady_clock::now();
+  return std::chrono::duration<double>(stop - start).count();
+}
+
+/// Runs f `repeats` times; returns the sorted wall times in seconds.
+template <class F>
+std::vector<double> time_repeats(int repeats, F&& f) {
+  std::vector<double> seconds;
+  for (int r = 0; r < repeats; ++r) seconds.push_back(seconds_of(f));
+  std::sort(seconds.begin(), seconds.end());
+  return seconds;
+}
+
+/// Median of sorted values (mean of the middle two for an even count).
+inline double median_of_sorted(const std::vector<double>& v) {
+  if (v.empty()) return 0.0;
+  const std::size_t m = v.size() / 2;
+  return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
+}
+
+/// Median wall time of f over `repeats` runs, in seconds.
+template <class F>
+double median_seconds(int repeats, F&& f) {
+  return median_of_sorted(time_repeats(repeats, std::forward<F>(f)));
+}
+
+/// A table cell: text, or a number shown with a fixed number of decimals (and written to JSON
+/// as a number).
+struct Cell {
+  std::string text;
+  std::optional<double> number;
+
+  Cell(const char* s) : text(s) {}             // NOLINT: implicit on purpose, for row literals
+  Cell(std::string s) : text(std::move(s)) {}  // NOLINT
+  static Cell num(double value, int decimals) {
+    std::ostringstream out;
+    out << std::fixed << std::setprecision(decimals) << value;
+    Cell c(out.str());
+    c.number = value;
+    return c;
+  }
+  static Cell integer(long long value) {
+    Cell c(std::to_string(value));
+    c.number = static_cast<double>(value);
+    return c;
+  }
+};
+
+inline std::string json_string(const std::string& s) {
+  std::string out = "\"";
+  for (const char ch : s) {
+    switch (ch) {
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
+      default:
+        if (static_cast<unsigned char>(ch) < 0x20) {
+          char buf[8];
+          std::snprintf(buf, sizeof buf, "\\u%04x", ch);
+          out += buf;
+        } else {
+          out += ch;
+        }
+    }
+  }
+  return out + "\"";
+}
+
+inline std::string json_value(const Cell& c) {
+  if (!c.number) return json_string(c.text);
+  std::ostringstream out;
+  out << std::setprecision(10) << *c.number;
+  return out.str();
+}
+
+class Table {
+ public:
+  explicit Table(std::vector<std::string> columns) : columns_(std::move(columns)) {}
+
+  void add_row(std::vector<Cell> row) {
+    row.resize(columns_.size(), Cell(""));
+    rows_.push_back(std::move(row));
+  }
+  const std::vector<std::vector<Cell>>& rows() const { return rows_; }
+
+  /// Markdown-compatible aligned table: numbers right-aligned, text left-aligned.
+  void print(std::ostream& out) const {
+    std::vector<std::size_t> width(columns_.size());
+    for (std::size_t c = 0; c < columns_.size(); ++c) width[c] = columns_[c].size();
+    for (const auto& row : rows_)
+      for (std::size_t c = 0; c < row.size(); ++c)
+        width[c] = std::max(width[c], row[c].text.size());
+    auto line = [&](auto cell_text, auto right) {
+      out << "|";
+      for (std::size_t c = 0; c < columns_.size(); ++c) {
+        out << " " << (right(c) ? std::right : std::left) << std::setw(static_cast<int>(width[c]))
+            << cell_text(c) << " |";
+      }
+      out << "\n";
+    };
+    line([&](std::size_t c) { return columns_[c]; }, [](std::size_t) { return false; });
+    out << "|";
+    for (std::size_t c = 0; c < columns_.size(); ++c) out << std::string(width[c] + 2, '-') << "|";
+    out << "\n";
+    for (const auto& row : rows_)
+      line([&](std::size_t c) { return row[c].text; },
+           [&](std::size_t c) { return row[c].number.has_value(); });
+    out << std::left;
+  }
+
+  /// {"benchmark": name, "machine": {...}, "repeats": n, "parameters": {...}, "rows": [...],
+  ///  "notes": {...}}; parameters and notes are (key, cell) pairs.
+  void write_json(std::ostream& out, const std::string& name, const Machine& m, int repeats,
+                  const std::vector<std::pair<std::string, Cell>>& parameters,
+                  const std::vector<std::pair<std::string, Cell>>& notes = {}) const {
+    auto object = [&](const std::vector<std::pair<std::string, Cell>>& fields) {
+      std::string s = "{";
+      for (std::size_t i = 0; i < fields.size(); ++i)
+        s += (i ? ", " : "") + json_string(fields[i].first) + ": " + json_value(fields[i].second);
+      return s + "}";
+    };
+    out << "{\n  \"benchmark\": " << json_string(name) << ",\n"
+        << "  \"machine\": {\"nproc\": " << m.threads << ", \"cpu\": " << json_string(m.cpu)
+        << ", \"load_average\": " << json_string(m.load) << "},\n"
+        << "  \"repeats\": " << repeats << ",\n"
+        << "  \"parameters\": " << object(parameters) << ",\n"
+        << "  \"rows\": [";
+    for (std::size_t r = 0; r < rows_.size(); ++r) {
+      std::vector<std::pair<std::string, Cell>> fields;
+      for (std::size_t c = 0; c < columns_.size(); ++c)
+        fields.emplace_back(columns_[c], rows_[r][c]);
+      out << (r ? ",\n    " : "\n    ") << object(fields);
+    }
+    out << "\n  ],\n  \"notes\": " << object(notes) << "\n}\n";
+  }
+
+ private:
+  std::vector<std::string> columns_;
+  std::vector<std::vector<Cell>> rows_;
+};
+
+}  // namespace ulc_bench
