@@ -1,0 +1,66 @@
+// `ulc`: the command-line front end. Dispatches to a subcommand and turns exceptions into one
+// clear line on stderr and an exit code (DESIGN.md, "The command line").
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <string>
+
+#include "cli_args.hpp"
+#include "commands.hpp"
+#include "ulc/io/io_error.hpp"
+#include "ulc/version.hpp"
+
+namespace {
+
+constexpr ulc::app::Command kCommands[] = {
+    {"inspect", "print what a cloud file or a frame folder holds", ulc::app::run_inspect},
+    {"evaluate", "compare a result file with ground truth (e_rot, e_trans, time offset)",
+     ulc::app::run_evaluate},
+};
+
+void print_usage(std::FILE* to) {
+  std::fprintf(to,
+               "ulc %s: universal LiDAR-to-LiDAR calibration\n\nusage: ulc <command> "
+               "[options]\n\ncommands:\n",
+               ULC_VERSION_STRING);
+  for (const auto& c : kCommands) std::fprintf(to, "  %-12s %s\n", c.name, c.summary);
+  std::fprintf(to, "\n`ulc <command> --help` describes a command's options.\n");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    print_usage(stderr);
+    return ulc::app::kExitUsage;
+  }
+  const std::string name = argv[1];
+  if (name == "--help" || name == "-h" || name == "help") {
+    print_usage(stdout);
+    return ulc::app::kExitOk;
+  }
+  if (name == "--version") {
+    std::printf("ulc %s\n", ULC_VERSION_STRING);
+    return ulc::app::kExitOk;
+  }
+  for (const auto& c : kCommands) {
+    if (name != c.name) continue;
+    try {
+      return c.run(argc - 1, argv + 1);
+    } catch (const ulc::cli::UsageError& e) {
+      std::fprintf(stderr, "ulc %s\n", e.what());
+      return ulc::app::kExitUsage;
+    } catch (const ulc::io::IoError& e) {
+      std::fprintf(stderr, "ulc %s: %s\n", c.name, e.what());
+      return ulc::app::kExitUsage;
+    } catch (const std::bad_alloc&) {
+      std::fprintf(stderr, "ulc %s: out of memory\n", c.name);
+      return ulc::app::kExitFailed;
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "ulc %s: %s\n", c.name, e.what());
+      return ulc::app::kExitFailed;
+    }
+  }
+  std::fprintf(stderr, "ulc: unknown command '%s' (try `ulc --help`)\n", name.c_str());
+  return ulc::app::kExitUsage;
+}

@@ -1,0 +1,103 @@
+// The calibration result file of DESIGN.md ("Result file"): one entry per target LiDAR inside
+// "results", each with the transform in four spellings (matrix, translation, quaternion wxyz,
+// roll/pitch/yaw in degrees with R = Rz(yaw) Ry(pitch) Rx(roll)), the clock offset, a 6x6
+// covariance, per-stage statistics and timings. A failed calibration still has its entry, with
+// success false, a status word and a human reason.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "ulc/core/lie.hpp"
+#include "ulc/io/json.hpp"
+#include "ulc/io/json_eigen.hpp"
+
+namespace ulc::io {
+
+struct PairResult {
+  std::string base;
+  std::string target;
+  bool success = false;
+  std::string status = "not_run";
+  std::string reason;
+  Eigen::Isometry3d T_base_target = Eigen::Isometry3d::Identity();
+  std::optional<double> time_offset_s;  ///< t_base_clock = t_target_clock + time_offset_s
+  std::optional<Eigen::Matrix<double, 6, 6>> covariance_6x6;  ///< tangent order [rho; phi]
+  Json stages = Json::object();    ///< {"terra": {...}, "jeep": {...}, "hots": {...}}
+  Json timing_s = Json::object();  ///< seconds per stage and "total"
+};
+
+inline Json to_json(const PairResult& r) {
+  constexpr double kDeg = 180.0 / 3.14159265358979323846;
+  Json e = Json::object();
+  e["base"] = r.base;
+  e["target"] = r.target;
+  e["success"] = r.success;
+  e["status"] = r.status;
+  e["reason"] = r.reason;
+  e["T_base_target"] = matrix_to_json(r.T_base_target.matrix());
+  e["translation_m"] = vector_to_json(r.T_base_target.translation());
+  const Eigen::Quaterniond q(r.T_base_target.linear());
+  e["rotation_quat_wxyz"] = vector_to_json(Eigen::Vector4d(q.w(), q.x(), q.y(), q.z()));
+  e["rpy_deg"] = vector_to_json(ulc::rpy_from_rotation(r.T_base_target.linear()) * kDeg);
+  e["time_offset_s"] = r.time_offset_s ? Json(*r.time_offset_s) : Json();
+  e["covariance_6x6"] = r.covariance_6x6 ? matrix_to_json(*r.covariance_6x6) : Json();
+  e["stages"] = r.stages;
+  e["timing_s"] = r.timing_s;
+  return e;
+}
+
+inline Json results_to_json(const std::vector<PairResult>& results) {
+  Json list = Json::array();
+  for (const auto& r : results) list.push_back(to_json(r));
+  Json doc = Json::object();
+  doc["results"] = std::move(list);
+  return doc;
+}
+
+/// Reads the fields a consumer needs (the matrix is authoritative over the other spellings).
+inline std::vector<PairResult> results_from_json(const Json& doc, const std::string& file) {
+  const Json* list = doc.find("results");
+  if (!list || !list->is_array())
+    throw IoError(file, "results", "missing array \"results\" (is this a ulc result file?)");
+  std::vector<PairResult> out;
+  for (std::size_t i = 0; i < list->size(); ++i) {
+    const Json& e = (*list)[i];
+    const std::string where = "results[" + std::to_string(i) + "]";
+    if (!e.is_object()) throw IoError(file, where, "expected an object");
+    PairResult r;
+    const Json* base = e.find("base");
+    const Json* target = e.find("target");
+    if (!base || !base->is_string() || !target || !target->is_string())
+      throw IoError(file, where, "needs string \"base\" and \"target\"");
+    r.base = base->as_string();
+    r.target = target->as_string();
+    if (const Json* s = e.find("success"); s && s->is_bool()) r.success = s->as_bool();
+    if (const Json* s = e.find("status"); s && s->is_string()) r.status = s->as_string();
+    if (const Json* s = e.find("reason"); s && s->is_string()) r.reason = s->as_string();
+    const Json* t = e.find("T_base_target");
+    if (!t) throw IoError(file, where, "missing T_base_target");
+    r.T_base_target = json_to_isometry(*t, file, where + ".T_base_target");
+    if (const Json* dt = e.find("time_offset_s"); dt && dt->is_number())
+      r.time_offset_s = dt->as_number();
+    if (const Json* c = e.find("covariance_6x6"); c && c->is_array())
+      r.covariance_6x6 = json_to_matrix<6, 6>(*c, file, where + ".covariance_6x6");
+    if (const Json* s = e.find("stages"); s && s->is_object()) r.stages = *s;
+    if (const Json* s = e.find("timing_s"); s && s->is_object()) r.timing_s = *s;
+    out.push_back(std::move(r));
+  }
+  return out;
+}
+
+inline std::vector<PairResult> read_result_file(const std::string& path) {
+  return results_from_json(read_json_file(path), path);
+}
+
+inline void write_result_file(const std::string& path, const std::vector<PairResult>& results) {
+  write_json_file(path, results_to_json(results));
+}
+
+}  // namespace ulc::io

@@ -1,0 +1,15 @@
+#!/usr/bin/env bash
+# Installs what ULC needs on Debian 12 (run as root). Only Debian packages; nothing downloaded
+# from elsewhere. Safe to run again.
+set -euo pipefail
+packages=(g++ cmake ninja-build libeigen3-dev libtbb-dev libnanoflann-dev catch2 libstb-dev)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "installing: ${missing[*]}" >&2
+  export DEBIAN_FRONTEND=noninteractive
+  apt-get update -qq
+  apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
