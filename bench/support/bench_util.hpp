@@ -20,6 +20,8 @@
 #include <utility>
 #include <vector>
 
+#include "ulc/io/json.hpp"
+
 namespace ulc_bench {
 
 struct Options {
@@ -124,32 +126,7 @@ struct Cell {
 };
 
 inline std::string json_string(const std::string& s) {
-  std::string out = "\"";
-  for (const char ch : s) {
-    switch (ch) {
-      case '"':
-        out += "\\\"";
-        break;
-      case '\\':
-        out += "\\\\";
-        break;
-      case '\n':
-        out += "\\n";
-        break;
-      case '\t':
-        out += "\\t";
-        break;
-      default:
-        if (static_cast<unsigned char>(ch) < 0x20) {
-          char buf[8];
-          std::snprintf(buf, sizeof buf, "\\u%04x", ch);
-          out += buf;
-        } else {
-          out += ch;
-        }
-    }
-  }
-  return out + "\"";
+  return ulc::io::Json(s).dump(-1);
 }
 
 inline std::string json_value(const Cell& c) {

@@ -35,14 +35,7 @@ std::vector<unsigned char> encode_ply(const Cloud& cloud,
   std::vector<unsigned char> out(header.begin(), header.end());
 
   if (format == PlyFormat::ascii) {
-    std::string text;
-    for (std::size_t i = 0; i < n; ++i) {
-      for (std::size_t k = 0; k < specs.size(); ++k) {
-        if (k) text += ' ';
-        detail::append_value(text, detail::out_value(cloud, i, specs[k].field), specs[k].size);
-      }
-      text += '\n';
-    }
+    const std::string text = detail::ascii_rows(cloud, specs);
     out.insert(out.end(), text.begin(), text.end());
     return out;
   }

@@ -89,6 +89,21 @@ inline void append_value(std::string& text, double v, std::size_t size) {
     append_number(text, static_cast<float>(v));
 }
 
+/// The ascii body shared by PCD and PLY: one line per point, fields separated by spaces.
+template <typename Cloud>
+std::string ascii_rows(const Cloud& cloud, const std::vector<OutFieldSpec>& specs) {
+  std::string text;
+  const std::size_t n = traits::size(cloud);
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t k = 0; k < specs.size(); ++k) {
+      if (k) text += ' ';
+      append_value(text, out_value(cloud, i, specs[k].field), specs[k].size);
+    }
+    text += '\n';
+  }
+  return text;
+}
+
 }  // namespace detail
 
 }  // namespace ulc::io
