@@ -2,7 +2,8 @@
 #include <catch2/catch.hpp>
 #include <vector>
 
-#include "ulc/core/cloud.hpp"
+// Only the traits header: it must bring every built-in cloud type with it.
+#include "ulc/core/point_traits.hpp"
 
 namespace {
 

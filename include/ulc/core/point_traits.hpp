@@ -264,3 +264,8 @@ constexpr bool can_store_normal_v = detail::has_set_normal<remove_cvref_t<C>>::v
 
 }  // namespace traits
 }  // namespace ulc
+
+// The built-in specialisations come with the traits, so that no translation unit can see the
+// primary template for a built-in cloud type while another sees its specialisation.
+#include "ulc/core/builtin_traits.hpp"  // IWYU pragma: export
+#include "ulc/core/point_cloud.hpp"     // IWYU pragma: export
