@@ -1,0 +1,128 @@
+// A planar driving path of straight lines and circular arcs, parametrised by arc length.
+//
+// Conventions this header owns:
+//   - Heading is the angle of the direction of travel from the world x axis (counter-
+//     clockwise, radians); curvature is dheading/ds (positive: turning left).
+//   - at(s) is exact (closed form per segment), continuous in position and heading; before 0
+//     it clamps, beyond length() it continues straight along the final heading.
+//   - Corners are filleted: add a corner point and a radius, and the path turns on the arc
+//     tangent to both legs (fillet_polyline).
+#pragma once
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace ulc::sim {
+
+struct PathPoint {
+  Eigen::Vector2d position = Eigen::Vector2d::Zero();
+  double heading = 0.0;
+  double curvature = 0.0;
+};
+
+class Path2d {
+ public:
+  Path2d() = default;
+  Path2d(const Eigen::Vector2d& start, double heading) : end_{start, heading, 0.0} {}
+
+  /// Straight ahead by `length` metres.
+  void add_line(double length) { add_segment(length, 0.0); }
+  /// An arc of the given radius turning by `sweep` radians (positive: left).
+  void add_arc(double radius, double sweep) {
+    if (sweep == 0.0 || radius <= 0.0) return;
+    add_segment(radius * std::abs(sweep), (sweep > 0 ? 1.0 : -1.0) / radius);
+  }
+
+  double length() const { return segments_.empty() ? 0.0 : segments_.back().s1(); }
+  bool empty() const { return segments_.empty(); }
+  /// Where the path currently ends (the start of the next segment).
+  const PathPoint& end() const { return end_; }
+
+  PathPoint at(double s) const {
+    if (segments_.empty()) return end_;
+    s = std::max(s, 0.0);
+    if (s >= length()) {
+      PathPoint p = end_;
+      p.position += (s - length()) * Eigen::Vector2d(std::cos(p.heading), std::sin(p.heading));
+      p.curvature = 0.0;
+      return p;
+    }
+    // Last segment starting at or before s.
+    auto it = std::upper_bound(segments_.begin(), segments_.end(), s,
+                               [](double v, const Segment& seg) { return v < seg.s0; });
+    const Segment& seg = *(it - 1);
+    return seg.eval(s - seg.s0);
+  }
+
+ private:
+  struct Segment {
+    double s0;
+    double length;
+    double curvature;
+    PathPoint start;
+    double s1() const { return s0 + length; }
+    PathPoint eval(double u) const {
+      PathPoint p;
+      p.curvature = curvature;
+      const double h0 = start.heading;
+      if (curvature == 0.0) {
+        p.heading = h0;
+        p.position = start.position + u * Eigen::Vector2d(std::cos(h0), std::sin(h0));
+      } else {
+        const double h = h0 + curvature * u;
+        p.heading = h;
+        p.position =
+            start.position +
+            Eigen::Vector2d(std::sin(h) - std::sin(h0), std::cos(h0) - std::cos(h)) / curvature;
+      }
+      return p;
+    }
+  };
+
+  void add_segment(double length, double curvature) {
+    if (!(length > 0.0)) return;
+    Segment seg{this->length(), length, curvature, end_};
+    seg.start.curvature = curvature;
+    segments_.push_back(seg);
+    end_ = seg.eval(length);
+    end_.curvature = 0.0;
+  }
+
+  std::vector<Segment> segments_;
+  PathPoint end_;
+};
+
+/// One corner of a polyline to be filleted: the turn happens at `point` with `radius`.
+struct PathCorner {
+  Eigen::Vector2d point;
+  double radius;
+};
+
+/// A path from `start` through filleted corners to `finish`. Each leg must be long enough for
+/// the tangent lengths of the fillets at its ends (the caller's road geometry guarantees it).
+inline Path2d fillet_polyline(const Eigen::Vector2d& start, const std::vector<PathCorner>& corners,
+                              const Eigen::Vector2d& finish) {
+  std::vector<Eigen::Vector2d> pts;
+  pts.push_back(start);
+  for (const PathCorner& c : corners) pts.push_back(c.point);
+  pts.push_back(finish);
+  const Eigen::Vector2d d0 = (pts[1] - pts[0]).normalized();
+  Path2d path(start, std::atan2(d0.y(), d0.x()));
+  Eigen::Vector2d cursor = start;
+  for (std::size_t k = 0; k < corners.size(); ++k) {
+    const Eigen::Vector2d din = (pts[k + 1] - pts[k]).normalized();
+    const Eigen::Vector2d dout = (pts[k + 2] - pts[k + 1]).normalized();
+    const double turn = std::atan2(din.x() * dout.y() - din.y() * dout.x(), din.dot(dout));
+    const double tangent = corners[k].radius * std::tan(std::abs(turn) / 2.0);
+    const Eigen::Vector2d arc_start = pts[k + 1] - tangent * din;
+    path.add_line((arc_start - cursor).norm());
+    path.add_arc(corners[k].radius, turn);
+    cursor = pts[k + 1] + tangent * dout;
+  }
+  path.add_line((finish - cursor).norm());
+  return path;
+}
+
+}  // namespace ulc::sim
