@@ -7,9 +7,13 @@ bash scripts/install_deps.sh
 jobs=${ULC_JOBS:-$(nproc)}
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DULC_BUILD_TESTS=OFF -DULC_BUILD_BENCH=OFF
 cmake --build build -j "$jobs" --target ulc_app example_custom_point_type
+ulc=./build/apps/ulc/ulc
 ./build/examples/example_custom_point_type
+out=${ULC_OUT:-/tmp/ulc_demo}
+$ulc simulate --scenario 64-32 --seconds 3 --seed 1 --out "$out/64-32" --preview "$out/64-32.png"
+$ulc inspect "$out/64-32/lidar64"
+$ulc inspect "$out/64-32/lidar32"
 sample=../shared/data/real/croon_0003
 if [ -d "$sample" ]; then
-  ./build/apps/ulc/ulc inspect "$sample/top.pcd"
-  ./build/apps/ulc/ulc inspect "$sample/left.pcd"
+  $ulc inspect "$sample/top.pcd"
 fi

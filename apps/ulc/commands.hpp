@@ -16,5 +16,6 @@ struct Command {
 
 int run_inspect(int argc, char** argv);
 int run_evaluate(int argc, char** argv);
+int run_simulate(int argc, char** argv);
 
 }  // namespace ulc::app

@@ -13,6 +13,8 @@
 namespace {
 
 constexpr ulc::app::Command kCommands[] = {
+    {"simulate", "write a simulated multi-LiDAR dataset with exact ground truth",
+     ulc::app::run_simulate},
     {"inspect", "print what a cloud file or a frame folder holds", ulc::app::run_inspect},
     {"evaluate", "compare a result file with ground truth (e_rot, e_trans, time offset)",
      ulc::app::run_evaluate},
