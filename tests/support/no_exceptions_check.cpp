@@ -1,5 +1,6 @@
 // Compiled with -fno-exceptions: every algorithm header must build this way (DESIGN.md).
 // Add each new algorithm header here.
+#include "terra/terra.hpp"
 #include "ulc/core/cloud.hpp"
 #include "ulc/core/kdtree.hpp"
 #include "ulc/core/lie.hpp"

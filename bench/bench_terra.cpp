@@ -1,0 +1,505 @@
+// bench_terra: speed of TERRA's pieces and of the whole two-step search, against the paper's
+// kd-tree lookup and against the naive way (turn the cloud, rebuild the descriptor), measured in
+// the same run; and, with --accuracy, TERRA against scancontext* on simulated rig pairs.
+//
+//   ./build/bench/bench_terra [--json] [--repeats N]
+//   ./build/bench/bench_terra --accuracy [--pairs 64-32,32-16] [--samples 50] [--seed 1]
+//                             [--lattice 10000] [--adaptive-d1] [--min-overlap 0.2]
+//                             [--top-k 10] [--coarse-stride 10] [--d1 20] [--d2 5]
+//                             [--alpha 2] [--threads 2] [--json]
+//
+// Speed mode scenes: the synthetic crossroads of the tests (a 100k-point frame of an 80-beam
+// LiDAR, and a 32-beam target turned and 0.5 m away), and a simulated 64-32 frame pair
+// (HDL-64E and VLP-32C on one car, ulc::sim), the paper's reference task. Every timing is the
+// median over --repeats runs, in a tbb::task_arena of the given thread count.
+//
+// Accuracy mode: for each pair scenario, --samples frame pairs spread along a simulated drive;
+// the target frame is turned by a rotation uniform on SO(3) (seeded, terra::profile_case), so
+// no method can lean on the mount being near the identity. Success: e_rot < 10 deg.
+#include <tbb/task_arena.h>
+#include <Eigen/Core>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <iostream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "../tests/terra/terra_test_util.hpp"
+#include "support/bench_util.hpp"
+#include "terra/terra.hpp"
+#include "ulc/core/pose_error.hpp"
+#include "ulc/sim/sim.hpp"
+
+namespace {
+
+using ulc_bench::Cell;
+using Cloud = std::vector<ulc::Vec3d>;
+constexpr double kDeg = 3.14159265358979323846 / 180.0;
+
+template <class F>
+auto in_arena(int threads, F&& f) {
+  tbb::task_arena arena(threads);
+  return arena.execute(std::forward<F>(f));
+}
+
+/// The cube-map lookup queried one direction at a time (no batching): what batching saves.
+struct OneByOne {
+  const terra::Lattice& lattice;
+  std::size_t size() const { return lattice.size(); }
+  void nearest_batch(const ulc::Vec3d* q, std::size_t n, terra::LatticeIndex* out) const {
+    for (std::size_t k = 0; k < n; ++k) out[k] = lattice.nearest(q[k]);
+  }
+};
+
+/// The naive evaluation of one rotation: turn every target point, rebuild the descriptor,
+/// compare. Returns the distance (to keep the work observable).
+double naive_distance(const terra::Lattice& lattice, const terra::Descriptor<double>& base,
+                      const Cloud& target, const ulc::Mat3d& R, Cloud& scratch) {
+  scratch.resize(target.size());
+  for (std::size_t i = 0; i < target.size(); ++i) scratch[i] = R * target[i];
+  const auto g = terra::make_descriptor(lattice, scratch);
+  return terra::descriptor_distance(base, g, terra::DistanceParams()).distance;
+}
+
+std::string fmt(double v, int decimals) {
+  std::ostringstream out;
+  out.setf(std::ios::fixed);
+  out.precision(decimals);
+  out << v;
+  return out.str();
+}
+
+struct Pair {
+  std::string name;
+  Cloud base, target;
+  ulc::Mat3d R_base_target = ulc::Mat3d::Identity();
+};
+
+Cloud to_cloud(const ulc::PointCloud<float>& c) {
+  Cloud out;
+  out.reserve(c.size());
+  for (const auto& p : c.points) out.push_back(p.cast<double>());
+  return out;
+}
+
+/// Frame pairs of a simulated scenario's first pair, `samples` of them spread `spacing_s` apart
+/// along the drive; the target frame nearest in time to each base frame.
+std::vector<Pair> simulated_pairs(const std::string& name, std::size_t samples, double spacing_s,
+                                  std::uint64_t seed, std::string& error) {
+  std::vector<Pair> out;
+  auto spec = ulc::sim::scenario(name);
+  if (!spec || spec->pairs.empty()) {
+    error = "unknown scenario '" + name + "'";
+    return out;
+  }
+  const ulc::sim::LidarPair lp = spec->pairs.front();
+  ulc::sim::SimulationOptions options;
+  options.seed = seed;
+  options.seconds = spacing_s * static_cast<double>(samples) + 0.5;
+  options.keep_frames = false;
+  std::size_t base_index = 0, target_index = 0;
+  for (std::size_t i = 0; i < spec->lidars.size(); ++i) {
+    if (spec->lidars[i].name == lp.base) base_index = i;
+    if (spec->lidars[i].name == lp.target) target_index = i;
+  }
+  // Keep the base frames at the sample times and the target frames.
+  std::map<std::size_t, ulc::PointCloud<float>> base_frames, target_frames;
+  std::vector<double> base_time, target_time;
+  const double base_rate = spec->lidars[base_index].rate_hz;
+  const auto stride = static_cast<std::size_t>(std::max(1.0, std::round(spacing_s * base_rate)));
+  const auto sink = [&](const ulc::sim::FrameEvent& e) {
+    if (e.lidar == base_index && e.frame % stride == 0) base_frames[e.frame] = e.cloud;
+    // All target frames (~1 MB each): the nearest in time is chosen after the run, once the
+    // timestamps and the pair's clock offset are known.
+    if (e.lidar == target_index) target_frames[e.frame] = e.cloud;
+    return true;
+  };
+  const auto result = ulc::sim::simulate(*spec, options, sink);
+  if (!result.ok()) {
+    error = name + ": " + result.reason;
+    return out;
+  }
+  const auto& ds = result.dataset;
+  const ulc::sim::PairTruth* truth = nullptr;
+  for (const auto& p : ds.pairs)
+    if (p.base == lp.base && p.target == lp.target) truth = &p;
+  if (!truth) {
+    error = name + ": no ground truth for its pair";
+    return out;
+  }
+  const auto& bt = ds.lidars[base_index].timestamps;
+  const auto& tt = ds.lidars[target_index].timestamps;
+  for (const auto& [k, cloud] : base_frames) {
+    if (out.size() == samples) break;
+    // Target frame nearest in time: t_base_clock = t_target_clock + time_offset_s.
+    std::size_t best = 0;
+    double best_dt = 1e9;
+    for (std::size_t j = 0; j < tt.size(); ++j) {
+      const double dt = std::fabs(tt[j] + truth->time_offset_s - bt[k]);
+      if (dt < best_dt) best_dt = dt, best = j;
+    }
+    const auto it = target_frames.find(best);
+    if (it == target_frames.end()) continue;
+    Pair p;
+    p.name = name;
+    p.base = to_cloud(cloud);
+    p.target = to_cloud(it->second);
+    p.R_base_target = truth->T_base_target.linear();
+    out.push_back(std::move(p));
+  }
+  if (out.size() < samples) error = name + ": only " + std::to_string(out.size()) + " frame pairs";
+  return out;
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return std::nan("");
+  std::sort(v.begin(), v.end());
+  return ulc_bench::median_of_sorted(v);
+}
+
+// ---------------------------------------------------------------------------------------------
+
+int run_speed(const ulc_bench::Options& options) {
+  const int repeats = options.repeats;
+  ulc_bench::Table table({"case", "N", "threads", "median_ms", "per_item", "item", "detail"});
+
+  // Scenes.
+  Cloud frame = terra_test::scan(ulc::Mat3d::Identity(), ulc::Vec3d::Zero(), 80, 1800);  // ~100k
+  frame.resize(std::min<std::size_t>(frame.size(), 100000));
+  const Cloud base = terra_test::scan(ulc::Mat3d::Identity(), ulc::Vec3d::Zero(), 64, 1800);
+  terra::SplitMix64 rng(7);
+  const ulc::Mat3d R_gt = terra::random_rotation(rng);
+  const Cloud target = terra_test::scan(R_gt, ulc::Vec3d(0.4, -0.3, 0.1), 32, 1800);
+
+  // Lattice build.
+  for (std::size_t n : {1000u, 3000u, 10000u}) {
+    terra::Lattice lattice;
+    const double s = ulc_bench::median_seconds(repeats, [&] { lattice = terra::Lattice(n); });
+    table.add_row({"lattice + cube-map table build", Cell::integer(long(n)), Cell::integer(2),
+                   Cell::num(s * 1e3, 2), "", "",
+                   "M=" + std::to_string(lattice.grid().cells_per_edge()) + ", " +
+                       fmt(lattice.mean_candidates(), 2) + " cand/cell, " +
+                       fmt(double(lattice.table_bytes()) / 1e6, 2) + " MB"});
+  }
+
+  const terra::Lattice lattice(10000);
+  const terra::KdTreeLookup kd(lattice);
+
+  // Descriptor of a 100k-point frame.
+  for (int threads : {1, 2}) {
+    const double s = in_arena(threads, [&] {
+      return ulc_bench::median_seconds(repeats, [&] {
+        volatile std::size_t n = terra::make_descriptor(lattice, frame).points_used;
+        (void)n;
+      });
+    });
+    table.add_row({"descriptor of a frame", Cell::integer(10000), Cell::integer(threads),
+                   Cell::num(s * 1e3, 2), Cell::num(s * 1e9 / double(frame.size()), 1), "ns/point",
+                   std::to_string(frame.size()) + " points"});
+  }
+  {
+    const double s = in_arena(1, [&] {
+      return ulc_bench::median_seconds(repeats, [&] {
+        volatile std::size_t n = terra::make_descriptor(kd, frame).points_used;
+        (void)n;
+      });
+    });
+    table.add_row({"descriptor of a frame, kd-tree lookup", Cell::integer(10000), Cell::integer(1),
+                   Cell::num(s * 1e3, 2), Cell::num(s * 1e9 / double(frame.size()), 1), "ns/point",
+                   std::to_string(frame.size()) + " points"});
+  }
+
+  // One rotation evaluation: the fused loop with each lookup.
+  const auto f1 = terra::make_descriptor(lattice, base);
+  const auto f2 = terra::make_descriptor(lattice, target);
+  const terra::DistanceParams dp;
+  const auto bc = terra::base_cells(lattice, f1, dp.d1);
+  const auto tc = terra::target_cells(f2, dp.d1);
+  std::vector<ulc::Mat3d> rotations;
+  for (int i = 0; i < 200; ++i) rotations.push_back(terra::random_rotation(rng));
+  double fused_per_rotation = 0;
+  auto eval_row = [&](const char* name, const auto& lookup, std::size_t count) {
+    const double s = in_arena(1, [&] {
+      return ulc_bench::median_seconds(repeats, [&] {
+        double acc = 0;
+        for (std::size_t r = 0; r < count; ++r)
+          acc += terra::rotated_distance(bc, tc, lookup, rotations[r], dp).abs_sum;
+        volatile double sink = acc;
+        (void)sink;
+      });
+    });
+    const double per_rotation = s / double(count);
+    table.add_row({name, Cell::integer(10000), Cell::integer(1), Cell::num(per_rotation * 1e3, 4),
+                   Cell::num(per_rotation * 1e9 / double(bc.size()), 1), "ns/cell",
+                   std::to_string(bc.size()) + " base cells > d1; median_ms per rotation"});
+    return per_rotation;
+  };
+  fused_per_rotation = eval_row("rotation evaluation, O(1) cube map, batched", lattice, 200);
+  eval_row("rotation evaluation, O(1) cube map, one by one", OneByOne{lattice}, 200);
+  const double kd_per_rotation = eval_row("rotation evaluation, kd-tree (paper)", kd, 20);
+
+  // The naive way: turn the cloud, rebuild, compare.
+  for (const Cloud* cloud : {&target, static_cast<const Cloud*>(&frame)}) {
+    Cloud scratch;
+    const terra::Descriptor<double> fb = terra::make_descriptor(lattice, base);
+    for (int threads : {1, 2}) {
+      const std::size_t count = 10;
+      const double s = in_arena(threads, [&] {
+        return ulc_bench::median_seconds(repeats, [&] {
+          double acc = 0;
+          for (std::size_t r = 0; r < count; ++r)
+            acc += naive_distance(lattice, fb, *cloud, rotations[r], scratch);
+          volatile double sink = acc;
+          (void)sink;
+        });
+      });
+      const double per_rotation = s / double(count);
+      table.add_row(
+          {"naive: turn cloud + rebuild descriptor", Cell::integer(10000), Cell::integer(threads),
+           Cell::num(per_rotation * 1e3, 3), Cell::num(per_rotation / fused_per_rotation, 0),
+           "x fused",
+           std::to_string(cloud->size()) + " points; median_ms per rotation; fused is 1 thread"});
+    }
+  }
+  table.add_row({"kd-tree (paper) vs O(1) batched", Cell::integer(10000), Cell::integer(1), "",
+                 Cell::num(kd_per_rotation / fused_per_rotation, 1), "x slower", ""});
+
+  // The full two-step search on the synthetic pair.
+  auto search_rows = [&](const std::string& scene, const Cloud& b, const Cloud& t,
+                         const ulc::Mat3d& truth, std::vector<std::size_t> sizes) {
+    for (std::size_t n : sizes) {
+      const terra::Lattice lat(n);
+      for (int threads : {1, 2}) {
+        terra::SearchResult last;
+        const double s = in_arena(threads, [&] {
+          return ulc_bench::median_seconds(repeats,
+                                           [&] { last = terra::estimate_rotation(lat, b, t); });
+        });
+        const auto& st = last.stats;
+        const double error = ulc::rotation_error_rad(truth, last.rotation) / kDeg;
+        table.add_row(
+            {"full search, " + scene, Cell::integer(long(n)), Cell::integer(threads),
+             Cell::num(s * 1e3, 1),
+             Cell::num(st.seconds() * 1e9 / double(std::max<std::uint64_t>(1, st.cell_evaluations)),
+                       1),
+             "ns/cell",
+             std::string(terra::to_string(last.status)) + ", e_rot " + fmt(error, 2) +
+                 " deg; rotations " + std::to_string(st.overlap.rotations) + "/" +
+                 std::to_string(st.coarse.rotations) + "/" + std::to_string(st.fine.rotations) +
+                 "; base cells > d1 " + std::to_string(st.base_beyond_d1) + "; descriptors " +
+                 fmt(st.descriptor_seconds * 1e3, 1) + " ms"});
+      }
+    }
+  };
+  search_rows("synthetic crossroads 64/32 beams", base, target, R_gt, {1000, 3000, 10000});
+
+  std::string error;
+  const auto sim = simulated_pairs("64-32", 1, 0.5, 1, error);
+  if (!sim.empty()) {
+    search_rows("simulated 64-32 pair", sim[0].base, sim[0].target, sim[0].R_base_target, {10000});
+    Cloud scratch;
+    const auto fb = terra::make_descriptor(lattice, sim[0].base);
+    const auto fbt = terra::make_descriptor(lattice, sim[0].target);
+    const auto sbc = terra::base_cells(lattice, fb, dp.d1);
+    const auto stc = terra::target_cells(fbt, dp.d1);
+    const double fused =
+        in_arena(1,
+                 [&] {
+                   return ulc_bench::median_seconds(repeats, [&] {
+                     double acc = 0;
+                     for (const auto& R : rotations)
+                       acc += terra::rotated_distance(sbc, stc, lattice, R, dp).abs_sum;
+                     volatile double sink = acc;
+                     (void)sink;
+                   });
+                 }) /
+        double(rotations.size());
+    const double naive =
+        in_arena(1,
+                 [&] {
+                   return ulc_bench::median_seconds(repeats, [&] {
+                     double acc = 0;
+                     for (std::size_t r = 0; r < 5; ++r)
+                       acc += naive_distance(lattice, fb, sim[0].target, rotations[r], scratch);
+                     volatile double sink = acc;
+                     (void)sink;
+                   });
+                 }) /
+        5.0;
+    table.add_row({"simulated 64-32: fused rotation evaluation", Cell::integer(10000),
+                   Cell::integer(1), Cell::num(fused * 1e3, 4),
+                   Cell::num(fused * 1e9 / double(sbc.size()), 1), "ns/cell",
+                   std::to_string(sbc.size()) + " base cells > d1"});
+    table.add_row({"simulated 64-32: naive per rotation", Cell::integer(10000), Cell::integer(1),
+                   Cell::num(naive * 1e3, 3), Cell::num(naive / fused, 0), "x fused",
+                   std::to_string(sim[0].target.size()) + " target points"});
+  } else {
+    table.add_row({"simulated 64-32", "", "", "", "", "", "skipped: " + error});
+  }
+
+  const ulc_bench::Machine m = ulc_bench::machine();
+  if (options.json) {
+    table.write_json(std::cout, "bench_terra", m, repeats,
+                     {{"d1_m", Cell::num(dp.d1, 1)},
+                      {"d2_m", Cell::num(dp.d2, 1)},
+                      {"alpha", Cell::num(dp.alpha, 1)}});
+  } else {
+    std::cout << "bench_terra on " << m.cpu << " (" << m.threads << " threads, load " << m.load
+              << "), median of " << repeats << "\n\n";
+    table.print(std::cout);
+  }
+  return 0;
+}
+
+// ---------------------------------------------------------------------------------------------
+
+struct AccuracyOptions {
+  std::vector<std::string> pairs = {"64-32"};
+  std::size_t samples = 50;
+  std::uint64_t seed = 1;
+  std::size_t lattice = 10000;
+  bool adaptive_d1 = false;
+  double min_overlap = terra::SearchParams().min_overlap_ratio;
+  int threads = 2;
+  double spacing_s = 0.2;
+  std::size_t top_k = terra::SearchParams().top_k;
+  double coarse_stride_deg = terra::SearchParams().coarse_stride_deg;
+  terra::DistanceParams distance;
+};
+
+int run_accuracy(const ulc_bench::Options& options, const AccuracyOptions& acc) {
+  ulc_bench::Table table({"pair", "samples", "terra_success_pct", "terra_median_deg",
+                          "terra_mean_s", "sc_success_pct", "sc_median_deg", "sc_mean_s", "note"});
+  const terra::Lattice lattice(acc.lattice);
+  terra::SearchParams params;
+  params.adaptive_d1.enabled = acc.adaptive_d1;
+  params.min_overlap_ratio = acc.min_overlap;
+  params.top_k = acc.top_k;
+  params.coarse_stride_deg = acc.coarse_stride_deg;
+  params.distance = acc.distance;
+  for (const std::string& name : acc.pairs) {
+    std::string error;
+    const auto pairs = simulated_pairs(name, acc.samples, acc.spacing_s, acc.seed, error);
+    if (pairs.empty()) {
+      table.add_row({name, "0", "", "", "", "", "", "", error});
+      continue;
+    }
+    std::vector<double> te, se;
+    double tt = 0, st = 0;
+    std::size_t ts = 0, ss = 0, adapted = 0;
+    for (std::size_t k = 0; k < pairs.size(); ++k) {
+      const Pair& p = pairs[k];
+      const std::uint64_t seed = acc.seed * 1000003u + k;
+      const auto c = in_arena(acc.threads, [&] {
+        return terra::profile_case(lattice, p.base, p.target, p.R_base_target, seed, params);
+      });
+      te.push_back(c.error_deg);
+      ts += c.error_deg < ulc::kRotationInitMaxRotationDeg;
+      tt += c.result.stats.seconds() + c.result.stats.descriptor_seconds;
+      adapted += c.result.stats.d1_adapted;
+      // scancontext* on the same turned target.
+      Cloud turned(p.target.size());
+      for (std::size_t i = 0; i < turned.size(); ++i) turned[i] = c.applied * p.target[i];
+      const auto t0 = std::chrono::steady_clock::now();
+      const auto sc = terra::scan_context_rotation(p.base, turned);
+      st += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      const double e = sc.ok ? ulc::rotation_error_rad(c.truth, sc.rotation) / kDeg : 180.0;
+      se.push_back(e);
+      ss += e < ulc::kRotationInitMaxRotationDeg;
+      if (!options.json)
+        std::cerr << name << " sample " << k << ": terra " << fmt(c.error_deg, 2) << " deg (d1 "
+                  << fmt(c.result.stats.d1_used, 1) << "), scancontext* " << fmt(e, 2) << " deg\n";
+    }
+    const double n = double(pairs.size());
+    table.add_row({name, Cell::integer(long(pairs.size())), Cell::num(100.0 * double(ts) / n, 1),
+                   Cell::num(median(te), 2), Cell::num(tt / n, 3),
+                   Cell::num(100.0 * double(ss) / n, 1), Cell::num(median(se), 2),
+                   Cell::num(st / n, 3),
+                   error.empty() ? "d1 adapted in " + std::to_string(adapted) : error});
+  }
+  const ulc_bench::Machine m = ulc_bench::machine();
+  if (options.json) {
+    table.write_json(std::cout, "bench_terra_accuracy", m, 1,
+                     {{"lattice", Cell::integer(long(acc.lattice))},
+                      {"seed", Cell::integer(long(acc.seed))},
+                      {"adaptive_d1", acc.adaptive_d1 ? "on" : "off"},
+                      {"min_overlap_ratio", Cell::num(acc.min_overlap, 2)},
+                      {"top_k", Cell::integer(long(acc.top_k))},
+                      {"coarse_stride_deg", Cell::num(acc.coarse_stride_deg, 1)},
+                      {"d1_m", Cell::num(acc.distance.d1, 1)},
+                      {"d2_m", Cell::num(acc.distance.d2, 1)},
+                      {"alpha", Cell::num(acc.distance.alpha, 2)},
+                      {"threads", Cell::integer(acc.threads)},
+                      {"success", "e_rot < 10 deg"}});
+  } else {
+    std::cout << "bench_terra --accuracy: target turned by a uniform random rotation per sample;"
+              << " success = e_rot < 10 deg; N = " << acc.lattice << ", adaptive d1 "
+              << (acc.adaptive_d1 ? "on" : "off") << ", min overlap ratio " << acc.min_overlap
+              << "\n\n";
+    table.print(std::cout);
+  }
+  return 0;
+}
+
+std::vector<std::string> split(const std::string& s) {
+  std::vector<std::string> out;
+  std::string item;
+  std::istringstream in(s);
+  while (std::getline(in, item, ','))
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // Our own options first; the rest go to the shared parser.
+  bool accuracy = false;
+  AccuracyOptions acc;
+  std::vector<char*> rest = {argv[0]};
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    const bool has_value = i + 1 < argc;
+    if (a == "--accuracy") {
+      accuracy = true;
+    } else if (a == "--pairs" && has_value) {
+      acc.pairs = split(argv[++i]);
+    } else if (a == "--samples" && has_value) {
+      acc.samples = std::max<std::size_t>(1, std::strtoul(argv[++i], nullptr, 10));
+    } else if (a == "--seed" && has_value) {
+      acc.seed = std::strtoull(argv[++i], nullptr, 10);
+    } else if (a == "--lattice" && has_value) {
+      acc.lattice = std::max<std::size_t>(2, std::strtoul(argv[++i], nullptr, 10));
+    } else if (a == "--adaptive-d1") {
+      acc.adaptive_d1 = true;
+    } else if (a == "--min-overlap" && has_value) {
+      acc.min_overlap = std::atof(argv[++i]);
+    } else if (a == "--top-k" && has_value) {
+      acc.top_k = std::max<std::size_t>(1, std::strtoul(argv[++i], nullptr, 10));
+    } else if (a == "--d1" && has_value) {
+      acc.distance.d1 = std::atof(argv[++i]);
+    } else if (a == "--d2" && has_value) {
+      acc.distance.d2 = std::atof(argv[++i]);
+    } else if (a == "--alpha" && has_value) {
+      acc.distance.alpha = std::atof(argv[++i]);
+    } else if (a == "--coarse-stride" && has_value) {
+      acc.coarse_stride_deg = std::atof(argv[++i]);
+    } else if (a == "--threads" && has_value) {
+      acc.threads = std::max(1, std::atoi(argv[++i]));
+    } else {
+      rest.push_back(argv[i]);
+    }
+  }
+  const ulc_bench::Options options = ulc_bench::parse_options(
+      static_cast<int>(rest.size()), rest.data(),
+      "TERRA speed (default) or accuracy against scancontext* (--accuracy [--pairs a,b] "
+      "[--samples 50] [--seed 1] [--lattice 10000] [--adaptive-d1] [--min-overlap 0.2] "
+      "[--threads 2])");
+  return accuracy ? run_accuracy(options, acc) : run_speed(options);
+}
