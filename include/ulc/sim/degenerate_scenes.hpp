@@ -41,26 +41,6 @@ inline Path2d highway_centerline(const HighwayLayout& h, std::uint64_t key, doub
   return path;
 }
 
-/// The same path shifted sideways by `offset` (positive: left), sampled into lines and arcs of
-/// the parallel curve (a parallel to an arc of radius R is an arc of radius R - offset).
-inline Path2d offset_path(const Path2d& center, double offset, double step = 5.0) {
-  const PathPoint p0 = center.at(0.0);
-  const Eigen::Vector2d normal0(-std::sin(p0.heading), std::cos(p0.heading));
-  Path2d out(p0.position + offset * normal0, p0.heading);
-  for (double s = 0.0; s < center.length(); s += step) {
-    const double ds = std::min(step, center.length() - s);
-    const PathPoint a = center.at(s + 0.5 * ds);
-    if (a.curvature == 0.0) {
-      out.add_line(ds);
-    } else {
-      const double radius = 1.0 / std::abs(a.curvature);
-      const double turn = a.curvature * ds;
-      out.add_arc(radius - (a.curvature > 0 ? offset : -offset), turn);
-    }
-  }
-  return out;
-}
-
 inline void add_highway(Scene& scene, const HighwayLayout& h, const Path2d& center) {
   const double length = center.length();
   GroundMeshSpec mesh;  // flat: a coarse grid only to vary the material

@@ -40,6 +40,22 @@ class Path2d {
   /// Where the path currently ends (the start of the next segment).
   const PathPoint& end() const { return end_; }
 
+  /// See offset_path().
+  Path2d offset(double offset) const {
+    const PathPoint p0 = at(0.0);
+    Path2d out(p0.position + offset * Eigen::Vector2d(-std::sin(p0.heading), std::cos(p0.heading)),
+               p0.heading);
+    for (const Segment& seg : segments_) {
+      if (seg.curvature == 0.0) {
+        out.add_line(seg.length);
+      } else {
+        const double radius = 1.0 / std::abs(seg.curvature);
+        out.add_arc(radius - (seg.curvature > 0.0 ? offset : -offset), seg.curvature * seg.length);
+      }
+    }
+    return out;
+  }
+
   PathPoint at(double s) const {
     if (segments_.empty()) return end_;
     s = std::max(s, 0.0);
@@ -123,6 +139,14 @@ inline Path2d fillet_polyline(const Eigen::Vector2d& start, const std::vector<Pa
   }
   path.add_line((finish - cursor).norm());
   return path;
+}
+
+/// The same path shifted sideways by `offset` metres (positive: left), segment by segment: a
+/// line stays a line of the same length, an arc of radius R turning by the same angle becomes
+/// one of radius R - offset (turning left) or R + offset (turning right). The offset must be
+/// smaller than every such radius.
+inline Path2d offset_path(const Path2d& center, double offset) {
+  return center.offset(offset);
 }
 
 }  // namespace ulc::sim

@@ -11,6 +11,7 @@
 //       (1 - base_dropout) * (1 - (r / r_eff)^3) * (1 - (1 - cos i)^4),
 //     r_eff = max_range * min(1, sqrt(reflectivity / reference_reflectivity)), i the
 //     incidence angle, so dropout grows with range, grazing incidence and dark surfaces.
+//   - Moving traffic (traffic.hpp) is seen at each ray's own instant.
 //   - Randomness per ray from hash_key(frame key, ray index): 1 and N threads, same bits.
 //     TBB parallel_for over fixed-size blocks of rays; each ray writes its own slot, then a
 //     serial pass compacts the hits in ray order. No allocation per ray.
@@ -27,6 +28,7 @@
 #include "ulc/core/point_cloud.hpp"
 #include "ulc/sim/scene.hpp"
 #include "ulc/sim/sensor_model.hpp"
+#include "ulc/sim/traffic.hpp"
 #include "ulc/sim/trajectory.hpp"
 
 namespace ulc::sim {
@@ -41,7 +43,8 @@ struct MountedSensor {
 
 /// Reused per-frame storage (one per concurrently rendered frame).
 struct FrameScratch {
-  PoseTable poses;  ///< T_world_vehicle over the frame's time span
+  PoseTable poses;                ///< T_world_vehicle over the frame's time span
+  std::vector<MovingBox> movers;  ///< traffic near the vehicle during the frame
   std::vector<Eigen::Vector3f> points;
   std::vector<float> intensity;
   std::vector<double> time;
@@ -76,10 +79,28 @@ inline double occluder_distance(const std::vector<OrientedBox>& occluders,
   return best;
 }
 
+/// Nearest moving box along the ray at frame time `dt` (lowers ray.t_max when found).
+inline bool moving_hit(const std::vector<MovingBox>& movers, double dt, Ray& ray, SurfaceHit& hit) {
+  bool found = false;
+  for (const MovingBox& m : movers) {
+    OrientedBox b = m.box;
+    b.center += m.velocity * dt;
+    const Vec3d c = b.center - ray.origin;
+    const double along = c.dot(ray.dir);
+    if (c.squaredNorm() - along * along > m.radius_sq || along < -std::sqrt(m.radius_sq)) continue;
+    if (b.intersect(ray, ray.t_max, hit)) {
+      ray.t_max = hit.t;
+      found = true;
+    }
+  }
+  return found;
+}
+
 template <class Pattern>
 void cast_rays(const Scene& scene, const PoseTable& poses, const MountedSensor& sensor,
                const Pattern& pattern, const FrameSetup& setup, std::uint64_t frame_key,
                std::size_t grain, FrameScratch& out) {
+  const std::vector<MovingBox>& movers = out.movers;
   const RangeModel& rm = sensor.model.range;
   const Mat3d R_vl = sensor.T_vehicle_lidar.linear();
   const Vec3d t_vl = sensor.T_vehicle_lidar.translation();
@@ -116,8 +137,13 @@ void cast_rays(const Scene& scene, const PoseTable& poses, const MountedSensor& 
           ray.dir = R_wv * (R_vl * d_true);
           ray.t_max = t_ego;
           ray.key = hash_key(frame_key, i, 0x776f726c64ULL);
-          SurfaceHit hit;
-          if (!scene.intersect(ray, hit) || hit.t < rm.min_range) continue;
+          SurfaceHit hit, mover;
+          const bool moving = !movers.empty() && moving_hit(movers, sr.time, ray, mover);
+          if (!scene.intersect(ray, hit)) {
+            if (!moving) continue;
+            hit = mover;
+          }
+          if (hit.t < rm.min_range) continue;
           const double cos_inc = std::min(1.0, std::abs(hit.normal.dot(ray.dir)));
           const double r_eff =
               rm.max_range * std::min(1.0, std::sqrt(static_cast<double>(hit.reflectivity) /
@@ -148,7 +174,8 @@ void cast_rays(const Scene& scene, const PoseTable& poses, const MountedSensor& 
 }  // namespace detail
 
 /// Casts one frame whose first firing is at `start_time` (true time) into `cloud`.
-/// `frame_key` seeds every random draw of the frame.
+/// `frame_key` seeds every random draw of the frame; scratch.movers holds the traffic boxes
+/// of the frame (at its start) and is left as given.
 inline void cast_frame(const Scene& scene, const VehicleTrajectory& trajectory,
                        const MountedSensor& sensor, double rate_hz, double start_time,
                        std::uint64_t frame_key, unsigned decimation, std::size_t grain,

@@ -48,6 +48,7 @@ struct ScenarioSpec {
   std::string description;
   SceneKind scene = SceneKind::town;
   MotionSpec motion;
+  double traffic_per_km = 12.0;  ///< oncoming cars per km of route (0: an empty road)
   std::vector<LidarMount> lidars;
   std::vector<LidarPair> pairs;
 
@@ -266,6 +267,7 @@ inline std::optional<ScenarioSpec> scenario(const std::string& name) {
     s.motion.min_speed = 8.0;
     s.motion.slowdowns_per_km = 0.0;
     s.motion.bumps = false;
+    s.traffic_per_km = 0.0;  // nothing may break the degeneracy
     return s;
   }
   if (name == "campus-ss") {

@@ -23,7 +23,7 @@
 //   sensor_tables.hpp   published elevation / azimuth tables
 //   trajectory.hpp      MotionSpec, VehicleTrajectory (pose at any t), PoseTable
 //   world.hpp           SceneKind, World, build_world(); town.hpp, degenerate_scenes.hpp,
-//                       scene_parts.hpp, ground.hpp build it
+//                       scene_parts.hpp, ground.hpp build it; traffic.hpp moves cars in it
 //   scene.hpp, bvh.hpp, primitives.hpp   geometry and closest-hit ray casting
 //   raycast.hpp         one frame: rays -> noisy, motion-distorted points
 //   vehicle.hpp         the ego body that blocks returns

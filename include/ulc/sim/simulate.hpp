@@ -155,7 +155,9 @@ class Simulator {
       horizon_ = std::max(horizon_, *options.static_at_s + 0.1);  // the parking spot is driven to
     }
     const double route_length = motion.max_speed * (horizon_ + 2.0) + 50.0;
-    world_ = build_world(spec_.scene, options.seed, route_length);
+    if (!(spec_.traffic_per_km >= 0.0 && spec_.traffic_per_km <= 200.0))
+      return SimCheck{SimStatus::invalid_scenario, "traffic_per_km must be in [0, 200]"};
+    world_ = build_world(spec_.scene, options.seed, route_length, spec_.traffic_per_km);
     trajectory_ = VehicleTrajectory(world_.route, world_.ground, motion,
                                     hash_key(options.seed, 0x647269ULL), horizon_);
     if (options.static_at_s) trajectory_.freeze_at(*options.static_at_s);
@@ -189,6 +191,9 @@ class Simulator {
 
   void render_frame(std::size_t lidar, std::size_t k, PointCloud<float>& cloud) {
     const std::uint64_t key = hash_key(options_.seed, lidar, k, 0x6672616d65ULL);
+    const double t0 = frame_start(lidar, k), t1 = t0 + 1.0 / spec_.lidars[lidar].rate_hz;
+    world_.traffic.frame_boxes(t0, t1, trajectory_.pose(t0).translation(),
+                               sensors_[lidar].model.range.max_range + 20.0, scratch_.movers);
     cast_frame(world_.scene, trajectory_, sensors_[lidar], spec_.lidars[lidar].rate_hz,
                frame_start(lidar, k), key, options_.decimation, options_.grain, scratch_, cloud);
   }

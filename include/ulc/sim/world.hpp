@@ -3,8 +3,9 @@
 // Conventions this header owns:
 //   - SceneKind names the three environments: town (the realistic one), highway and tunnel
 //     (the deliberately degenerate ones).
-//   - build_world is deterministic in (kind, seed, route_length): route_length is how far the
-//     vehicle may drive (the route is at least that long; degenerate scenes are sized to it).
+//   - build_world is deterministic in its arguments: route_length is how far the vehicle may
+//     drive (the route is at least that long; degenerate scenes are sized to it);
+//     traffic_per_km oncoming cars per kilometre of route (traffic.hpp), 0 for none.
 #pragma once
 
 #include <cstdint>
@@ -15,6 +16,7 @@
 #include "ulc/sim/path.hpp"
 #include "ulc/sim/scene.hpp"
 #include "ulc/sim/town.hpp"
+#include "ulc/sim/traffic.hpp"
 
 namespace ulc::sim {
 
@@ -36,12 +38,14 @@ struct World {
   Scene scene;
   GroundRelief ground;  ///< the surface the vehicle's wheels follow
   Path2d route;         ///< lane centre line the vehicle drives along
+  Traffic traffic;      ///< oncoming cars on the route's opposite lane
   TownLayout town;      ///< meaningful for SceneKind::town
   TunnelLayout tunnel;  ///< meaningful for SceneKind::tunnel
   HighwayLayout highway;
 };
 
-inline World build_world(SceneKind kind, std::uint64_t seed, double route_length) {
+inline World build_world(SceneKind kind, std::uint64_t seed, double route_length,
+                         double traffic_per_km = 0.0) {
   World w;
   w.kind = kind;
   const std::uint64_t key = hash_key(seed, 0x776f726c64ULL);
@@ -68,6 +72,11 @@ inline World build_world(SceneKind kind, std::uint64_t seed, double route_length
     }
   }
   w.scene.build();
+  const double lane = kind == SceneKind::town      ? w.town.lane_offset
+                      : kind == SceneKind::highway ? -w.highway.lane_offset()
+                                                   : -w.tunnel.lane_offset;
+  const int cars = static_cast<int>(std::round(traffic_per_km * w.route.length() / 1000.0));
+  w.traffic = Traffic(w.route, lane, w.ground, cars, hash_key(key, 5));
   return w;
 }
 
