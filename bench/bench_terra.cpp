@@ -4,7 +4,7 @@
 //
 //   ./build/bench/bench_terra [--json] [--repeats N]
 //   ./build/bench/bench_terra --accuracy [--pairs 64-32,32-16] [--samples 50] [--seed 1]
-//                             [--lattice 10000] [--adaptive-d1] [--min-overlap 0.2]
+//                             [--lattice 10000] [--[no-]adaptive-d1] [--min-overlap 0.2]
 //                             [--top-k 10] [--coarse-stride 10] [--d1 20] [--d2 5]
 //                             [--alpha 2] [--threads 2] [--json]
 //
@@ -364,7 +364,7 @@ struct AccuracyOptions {
   std::size_t samples = 50;
   std::uint64_t seed = 1;
   std::size_t lattice = 10000;
-  bool adaptive_d1 = false;
+  bool adaptive_d1 = terra::AdaptiveD1().enabled;
   double min_overlap = terra::SearchParams().min_overlap_ratio;
   int threads = 2;
   double spacing_s = 0.2;
@@ -478,6 +478,8 @@ int main(int argc, char** argv) {
       acc.lattice = std::max<std::size_t>(2, std::strtoul(argv[++i], nullptr, 10));
     } else if (a == "--adaptive-d1") {
       acc.adaptive_d1 = true;
+    } else if (a == "--no-adaptive-d1") {
+      acc.adaptive_d1 = false;
     } else if (a == "--min-overlap" && has_value) {
       acc.min_overlap = std::atof(argv[++i]);
     } else if (a == "--top-k" && has_value) {
@@ -499,7 +501,7 @@ int main(int argc, char** argv) {
   const ulc_bench::Options options = ulc_bench::parse_options(
       static_cast<int>(rest.size()), rest.data(),
       "TERRA speed (default) or accuracy against scancontext* (--accuracy [--pairs a,b] "
-      "[--samples 50] [--seed 1] [--lattice 10000] [--adaptive-d1] [--min-overlap 0.2] "
+      "[--samples 50] [--seed 1] [--lattice 10000] [--[no-]adaptive-d1] [--min-overlap 0.2] "
       "[--threads 2])");
   return accuracy ? run_accuracy(options, acc) : run_speed(options);
 }
