@@ -1,5 +1,8 @@
 // Compiled with -fno-exceptions: every algorithm header must build this way (DESIGN.md).
 // Add each new algorithm header here.
+#include "jeep/jeep.hpp"
+#include "jeep/run_odometry.hpp"
+#include "jeep/scan_scan.hpp"
 #include "terra/terra.hpp"
 #include "ulc/core/cloud.hpp"
 #include "ulc/core/kdtree.hpp"
@@ -7,6 +10,7 @@
 #include "ulc/core/normal_equations.hpp"
 #include "ulc/core/normals.hpp"
 #include "ulc/core/parallel_reduce.hpp"
+#include "ulc/core/point_to_plane.hpp"
 #include "ulc/core/pose_error.hpp"
 #include "ulc/core/rotation_mean.hpp"
 #include "ulc/core/voxel.hpp"

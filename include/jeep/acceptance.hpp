@@ -1,0 +1,132 @@
+// Acceptance of a calibration: is the extrinsic supported by the data, or did the registration
+// merely settle somewhere?
+//
+// Conventions this header owns:
+//   - Evidence is taken at the final C from map b (source) against map a's planes (target),
+//     with map b voxel-downsampled at `voxel`:
+//       near      = points of map b with a plane of map a within `gate`;
+//       agreeing  = near points with |point-to-plane residual| <= inlier_distance;
+//       overlap   = agreeing / near: how much of what both maps cover, they agree on;
+//       condition = lambda_min / lambda_max of the scaled, centred Hessian of the agreeing
+//                   points alone (registration_conditioning.hpp, unit weights): whether what
+//                   agrees pins down all six degrees of freedom, or only, say, the ground's
+//                   height, roll and pitch.
+//   - Rule: accepted iff agreeing >= min_agreeing, overlap >= min_overlap and condition >=
+//     min_condition.
+//   - Why these numbers: at the true extrinsic, a surface both LiDARs saw has residuals of range
+//     noise (a few cm), well inside inlier_distance = the paper's 10 cm success threshold, so
+//     the near points that disagree are only the clutter of edges, thin objects and occlusion
+//     borders: a minority, and min_overlap = 0.7 leaves room for 30% of it. Unrelated scenes
+//     agree on the ground and on whatever wall happens to coincide: about half of the near
+//     points. min_condition is the registration's own degeneracy threshold: an alignment
+//     resting on the ground alone is not a calibration. bench_jeep --separation measures both
+//     distributions on the paper's pairs (DESIGN.md: measure, do not guess).
+#pragma once
+
+#include <cmath>
+#include <cstddef>
+#include <vector>
+
+#include "jeep/map_registration.hpp"
+#include "ulc/core/normal_equations.hpp"
+#include "ulc/core/parallel_reduce.hpp"
+#include "ulc/core/point_to_plane.hpp"
+#include "ulc/core/registration_conditioning.hpp"
+#include "ulc/core/registration_target.hpp"
+#include "ulc/core/types.hpp"
+
+namespace jeep {
+
+struct AcceptanceOptions {
+  double voxel = 0.5;            ///< m, map b's resolution for the evidence
+  double gate = 1.0;             ///< m, "near": a map-a plane within this
+  double inlier_distance = 0.1;  ///< m, "agreeing": the success threshold of the paper
+  double min_overlap = 0.7;
+  double min_condition = 1e-3;  ///< as RegistrationOptions::min_condition
+  std::size_t min_agreeing = 100;
+};
+
+struct AcceptanceReport {
+  bool accepted = false;
+  const char* reason = "";
+  std::size_t points = 0;    ///< map b points examined
+  std::size_t near = 0;      ///< with a map-a plane within the gate
+  std::size_t agreeing = 0;  ///< of those, within inlier_distance of it
+  double overlap = 0.0;      ///< agreeing / near
+  double condition = 0.0;    ///< of the agreeing points' Hessian
+  double rmse = 0.0;         ///< m, RMS residual of the agreeing points
+};
+
+namespace detail {
+
+struct AgreementSums {
+  ulc::NormalEquations6 equations;
+  ulc::Vec3d sum_y = ulc::Vec3d::Zero();
+  double sum_yy = 0.0;
+  AgreementSums& operator+=(const AgreementSums& o) {
+    equations += o.equations;
+    sum_y += o.sum_y;
+    sum_yy += o.sum_yy;
+    return *this;
+  }
+};
+
+}  // namespace detail
+
+template <typename S>
+AcceptanceReport assess(const std::vector<Vec3<S>>& /*map_a*/, const std::vector<Vec3<S>>& map_b,
+                        const ulc::PlaneCloud<S>& target, const Isometry3d& C,
+                        const RegistrationResult<double>& /*calibration*/,
+                        const AcceptanceOptions& options) {
+  AcceptanceReport report;
+  const ulc::PointCloud<S> points = downsampled(map_b, options.voxel);
+  report.points = points.size();
+  using Term = ulc::PointToPlaneTerm<S, ulc::PlaneCloud<S>>;
+  const std::vector<Term> terms{
+      Term{points.points.data(), points.size(), &target, C, Isometry3d::Identity(), 1.0}};
+  ulc::PointToPlaneMatches matches;
+  report.near = ulc::match_point_to_plane(terms, Isometry3d::Identity(), options.gate, matches);
+  const ulc::PointToPlaneGeometry geometry(C, Isometry3d::Identity(), Isometry3d::Identity());
+  const auto& planes = matches[0];
+  const auto sums = ulc::deterministic_reduce(
+      points.size(), detail::AgreementSums{},
+      [&](std::size_t begin, std::size_t end, detail::AgreementSums acc) {
+        ulc::Vec6d J;
+        for (std::size_t i = begin; i < end; ++i) {
+          if (planes[i].normal.squaredNorm() == 0.0) continue;
+          const ulc::Vec3d y = geometry.pose_frame(points.points[i].template cast<double>());
+          const double r = geometry.residual(y, y, planes[i], &J);
+          if (std::abs(r) > options.inlier_distance) continue;
+          acc.equations.add(J, r);
+          acc.sum_y += y;
+          acc.sum_yy += y.squaredNorm();
+        }
+        return acc;
+      },
+      [](detail::AgreementSums a, const detail::AgreementSums& b) {
+        a += b;
+        return a;
+      },
+      ulc::kDefaultReduceGrain);
+  report.agreeing = sums.equations.count;
+  report.overlap = report.near ? static_cast<double>(report.agreeing) / report.near : 0.0;
+  if (report.agreeing > 0) {
+    const double n = static_cast<double>(report.agreeing);
+    const ulc::Vec3d c = sums.sum_y / n;
+    const double spread = std::sqrt(std::max(sums.sum_yy / n - c.squaredNorm(), 1e-18));
+    report.condition = ulc::scaled_condition(sums.equations.H, c, spread);
+    report.rmse = std::sqrt(sums.equations.cost / n);
+  }
+  if (report.agreeing < options.min_agreeing) {
+    report.reason = "too few points of map b agree with map a";
+  } else if (report.overlap < options.min_overlap) {
+    report.reason = "where the maps overlap, most of map b does not lie on map a's surfaces";
+  } else if (report.condition < options.min_condition) {
+    report.reason = "the points on which the maps agree leave a direction unconstrained";
+  } else {
+    report.accepted = true;
+  }
+  return report;
+}
+
+}  // namespace jeep

@@ -1,0 +1,156 @@
+// Odometry (the pose phase run along a drive): single- and multi-LiDAR poses against the
+// simulator's trajectory, poses for unpaired frames, the same bits on 1 and 2 threads.
+#include <tbb/task_arena.h>
+#include <catch2/catch.hpp>
+#include <cstring>
+#include <vector>
+
+#include "jeep/run_odometry.hpp"
+#include "jeep_test_util.hpp"
+#include "ulc/core/pose_error.hpp"
+
+using namespace jeep_test;
+
+namespace {
+
+/// One second of the 64-32 rig driving through town, columns decimated by 4.
+const ulc::sim::Dataset& drive() {
+  static const ulc::sim::Dataset d = [] {
+    DriveSpec spec;
+    spec.scenario = "64-32";
+    spec.seconds = 1.0;
+    spec.seed = 2;
+    spec.decimation = 4;
+    return simulate(spec);
+  }();
+  return d;
+}
+
+/// Largest error of the estimated poses against T_first^-1 T_k of the ground truth.
+ulc::PoseError worst_relative_error(const std::vector<Isometry3d>& estimated,
+                                    const std::vector<Isometry3d>& truth_world,
+                                    const Isometry3d& origin_world) {
+  ulc::PoseError worst;
+  for (std::size_t k = 0; k < estimated.size(); ++k) {
+    const auto e =
+        ulc::pose_error(Isometry3d(origin_world.inverse() * truth_world[k]), estimated[k]);
+    worst.rotation_deg = std::max(worst.rotation_deg, e.rotation_deg);
+    worst.translation_m = std::max(worst.translation_m, e.translation_m);
+  }
+  return worst;
+}
+
+std::vector<Isometry3d> truth_of(const ulc::sim::Dataset& d, std::size_t lidar,
+                                 const std::vector<double>& stamps) {
+  std::vector<Isometry3d> out;
+  for (double t : stamps) out.push_back(lidar_pose(d, lidar, t));
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("single-LiDAR odometry follows the simulated drive", "[jeep][odometry]") {
+  const auto& d = drive();
+  const auto& a = d.lidars[0];
+  REQUIRE(a.frames.size() >= 8);
+  const auto r = jeep::run_single_odometry(a.frames, a.timestamps);
+  INFO(jeep::to_string(r.status) << ": " << r.reason);
+  REQUIRE(r.ok());
+  REQUIRE(r.poses_a.size() == a.frames.size());
+  CHECK(r.poses_a[0].isApprox(Isometry3d::Identity(), 1e-12));
+  const auto truth = truth_of(d, 0, a.timestamps);
+  const auto e = worst_relative_error(r.poses_a, truth, truth[0]);
+  INFO("worst e_rot " << e.rotation_deg << " deg, e_trans " << e.translation_m << " m over "
+                      << (truth.back().translation() - truth[0].translation()).norm() << " m");
+  CHECK(e.rotation_deg < 0.1);
+  CHECK(e.translation_m < 0.03);
+}
+
+TEST_CASE("multi-LiDAR odometry gives both LiDARs' poses in their own map frames",
+          "[jeep][odometry]") {
+  const auto& d = drive();
+  const auto& a = d.lidars[0];
+  const auto& b = d.lidars[1];
+  const Isometry3d C = d.pairs[0].T_base_target;
+  const auto r = jeep::run_odometry(a.frames, a.timestamps, b.frames, b.timestamps, C);
+  INFO(jeep::to_string(r.status) << ": " << r.reason);
+  REQUIRE(r.ok());
+  REQUIRE(r.pairs.size() == a.frames.size());
+  // Map a: a's frame at its first timestamp; map b: b's frame at that same instant.
+  const Isometry3d origin_a = lidar_pose(d, 0, a.timestamps[0]);
+  const auto ea = worst_relative_error(r.poses_a, truth_of(d, 0, a.timestamps), origin_a);
+  const auto eb =
+      worst_relative_error(r.poses_b, truth_of(d, 1, b.timestamps), Isometry3d(origin_a * C));
+  INFO("a: " << ea.rotation_deg << " deg, " << ea.translation_m << " m; b: " << eb.rotation_deg
+             << " deg, " << eb.translation_m << " m");
+  CHECK(ea.rotation_deg < 0.1);
+  CHECK(ea.translation_m < 0.03);
+  CHECK(eb.rotation_deg < 0.1);
+  CHECK(eb.translation_m < 0.03);
+  // The rigid mount holds between every pair of poses: P_b = C^-1 P_a(t_b) C.
+  for (std::size_t k = 0; k < r.steps.size(); ++k) {
+    const auto& s = r.steps[k];
+    const Isometry3d Pa_tb = s.pose_a * ulc::se3_exp(Vec6d((s.t_b - s.t_a) * s.twist));
+    CHECK(s.pose_b.isApprox(Isometry3d(C.inverse() * Pa_tb * C), 1e-9));
+  }
+}
+
+TEST_CASE("odometry poses unpaired frames by extrapolating the nearest pair", "[jeep][odometry]") {
+  const auto& d = drive();
+  const auto& a = d.lidars[0];
+  const auto& b = d.lidars[1];
+  // b loses frames 3 and 4: a's frames 3 and 4 have no partner.
+  std::vector<ulc::PointCloud<float>> frames_b;
+  std::vector<double> times_b;
+  for (std::size_t k = 0; k < b.frames.size(); ++k) {
+    if (k == 3 || k == 4) continue;
+    frames_b.push_back(b.frames[k]);
+    times_b.push_back(b.timestamps[k]);
+  }
+  const Isometry3d C = d.pairs[0].T_base_target;
+  const auto r = jeep::run_odometry(a.frames, a.timestamps, frames_b, times_b, C);
+  REQUIRE(r.ok());
+  CHECK(r.pairs.size() == a.frames.size() - 2);
+  REQUIRE(r.poses_a.size() == a.frames.size());
+  REQUIRE(r.poses_b.size() == frames_b.size());
+  CHECK_FALSE(r.estimated_a[3]);
+  CHECK_FALSE(r.estimated_a[4]);
+  CHECK(r.estimated_a[5]);
+  for (bool e : r.estimated_b) CHECK(e);
+  const auto truth = truth_of(d, 0, a.timestamps);
+  const auto e = worst_relative_error(r.poses_a, truth, truth[0]);
+  CHECK(e.translation_m < 0.05);
+  CHECK(e.rotation_deg < 0.15);
+}
+
+TEST_CASE("odometry gives the same bits on 1 and 2 threads", "[jeep][odometry][threads]") {
+  const auto& d = drive();
+  const auto& a = d.lidars[0];
+  const auto& b = d.lidars[1];
+  const Isometry3d C = d.pairs[0].T_base_target;
+  auto run = [&] {
+    return jeep::run_odometry(a.frames, a.timestamps, b.frames, b.timestamps, C).poses_b;
+  };
+  tbb::task_arena one(1), two(2);
+  const auto p1 = one.execute(run);
+  const auto p2 = two.execute(run);
+  REQUIRE(p1.size() == p2.size());
+  for (std::size_t k = 0; k < p1.size(); ++k)
+    CHECK(std::memcmp(p1[k].matrix().data(), p2[k].matrix().data(), 16 * sizeof(double)) == 0);
+}
+
+TEST_CASE("odometry refuses unusable input", "[jeep][odometry]") {
+  const auto& a = drive().lidars[0];
+  std::vector<double> bad = a.timestamps;
+  bad[2] = bad[1] - 1.0;
+  CHECK(jeep::run_single_odometry(a.frames, bad).status == jeep::OdometryStatus::invalid_input);
+  std::vector<double> short_times(a.timestamps.begin(), a.timestamps.end() - 1);
+  CHECK(jeep::run_single_odometry(a.frames, short_times).status ==
+        jeep::OdometryStatus::invalid_input);
+  jeep::OdometryOptions o;
+  o.scan.map_voxel = -1;
+  CHECK(jeep::run_single_odometry(a.frames, a.timestamps, o).status ==
+        jeep::OdometryStatus::invalid_input);
+  const std::vector<ulc::PointCloud<float>> none;
+  CHECK(jeep::run_single_odometry(none, {}).status == jeep::OdometryStatus::no_pairs);
+}
