@@ -14,6 +14,7 @@ struct Command {
   int (*run)(int argc, char** argv);  ///< argv[0] is the subcommand name
 };
 
+int run_calibrate(int argc, char** argv);
 int run_inspect(int argc, char** argv);
 int run_evaluate(int argc, char** argv);
 int run_simulate(int argc, char** argv);

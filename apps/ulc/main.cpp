@@ -13,6 +13,8 @@
 namespace {
 
 constexpr ulc::app::Command kCommands[] = {
+    {"calibrate", "find the extrinsic of target LiDARs against a base LiDAR, with no guess",
+     ulc::app::run_calibrate},
     {"simulate", "write a simulated multi-LiDAR dataset with exact ground truth",
      ulc::app::run_simulate},
     {"inspect", "print what a cloud file or a frame folder holds", ulc::app::run_inspect},

@@ -164,13 +164,7 @@ inline SimulationResult simulate_to_directory(const std::filesystem::path& dir,
                                               const ProgressFn& progress = {}) {
   SimulationResult result;
   Simulator sim;
-  const SimCheck check = sim.init(spec, options);
-  if (!check.ok()) {
-    result.status = check.status;
-    result.reason = check.reason;
-    return result;
-  }
-  result.dataset = sim.metadata();
+  if (!start_simulation(sim, spec, options, result)) return result;
   DatasetWriter writer(dir);
   writer.begin(result.dataset);
   const auto order = sim.schedule();

@@ -84,6 +84,19 @@ struct FrameSetup {
   std::size_t rays = 0;
 };
 
+/// Set-up of a continuously firing scanner: `channels` lasers each firing `per_second` times a
+/// second, every `decimation`-th firing kept.
+inline FrameSetup continuous_setup(double rate_hz, double start_time, unsigned decimation,
+                                   double per_second, std::size_t channels) {
+  FrameSetup f;
+  f.rate_hz = rate_hz;
+  f.start_time = start_time;
+  f.decimation = decimation;
+  const auto samples = static_cast<std::size_t>(std::floor(per_second / rate_hz));
+  f.rays = (samples + decimation - 1) / decimation * channels;
+  return f;
+}
+
 /// A rotating multi-beam LiDAR (Velodyne, Ouster, Robosense, Hesai).
 struct SpinningLidar {
   std::vector<double> elevation_deg;       ///< per laser, laser-id order
@@ -197,13 +210,7 @@ struct RisleyLidar {
 
   FrameSetup setup(double rate_hz, double start_time, std::uint64_t /*frame_key*/,
                    unsigned decimation) const {
-    FrameSetup f;
-    f.rate_hz = rate_hz;
-    f.start_time = start_time;
-    f.decimation = decimation;
-    const auto samples = static_cast<std::size_t>(std::floor(channel_rate_hz / rate_hz));
-    f.rays = (samples + decimation - 1) / decimation * channels.size();
-    return f;
+    return continuous_setup(rate_hz, start_time, decimation, channel_rate_hz, channels.size());
   }
 
   SensorRay ray(std::size_t i, const FrameSetup& f) const {
@@ -271,13 +278,7 @@ struct MemsLidar {
 
   FrameSetup setup(double rate_hz, double start_time, std::uint64_t /*frame_key*/,
                    unsigned decimation) const {
-    FrameSetup f;
-    f.rate_hz = rate_hz;
-    f.start_time = start_time;
-    f.decimation = decimation;
-    const auto samples = static_cast<std::size_t>(std::floor(laser_rate_hz / rate_hz));
-    f.rays = (samples + decimation - 1) / decimation * zone_center_deg.size();
-    return f;
+    return continuous_setup(rate_hz, start_time, decimation, laser_rate_hz, zone_center_deg.size());
   }
 
   SensorRay ray(std::size_t i, const FrameSetup& f) const {

@@ -289,19 +289,26 @@ class Simulator {
   FrameScratch scratch_;
 };
 
+/// Initialises `sim`; on failure writes the status into `result`, else its metadata.
+inline bool start_simulation(Simulator& sim, const ScenarioSpec& spec,
+                             const SimulationOptions& options, SimulationResult& result) {
+  const SimCheck check = sim.init(spec, options);
+  if (!check.ok()) {
+    result.status = check.status;
+    result.reason = check.reason;
+    return false;
+  }
+  result.dataset = sim.metadata();
+  return true;
+}
+
 /// Runs the scenario. Frames go to `sink` as they are made (if given) and into the Dataset
 /// when options.keep_frames; `progress` hears about every frame.
 inline SimulationResult simulate(const ScenarioSpec& spec, const SimulationOptions& options,
                                  const FrameSink& sink = {}, const ProgressFn& progress = {}) {
   SimulationResult result;
   Simulator sim;
-  const SimCheck check = sim.init(spec, options);
-  if (!check.ok()) {
-    result.status = check.status;
-    result.reason = check.reason;
-    return result;
-  }
-  result.dataset = sim.metadata();
+  if (!start_simulation(sim, spec, options, result)) return result;
   const auto order = sim.schedule();
   PointCloud<float> cloud;
   for (std::size_t n = 0; n < order.size(); ++n) {
