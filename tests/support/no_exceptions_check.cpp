@@ -4,6 +4,7 @@
 #include "jeep/run_odometry.hpp"
 #include "jeep/scan_scan.hpp"
 #include "terra/terra.hpp"
+#include "ulc/calibrate.hpp"
 #include "ulc/core/cloud.hpp"
 #include "ulc/core/kdtree.hpp"
 #include "ulc/core/lie.hpp"
@@ -23,3 +24,8 @@ template ulc::NormalsResult<float> ulc::estimate_normals(const ulc::PointCloud<f
 template ulc::VoxelDownsampleResult<double> ulc::voxel_downsample(const ulc::PointCloud<double>&,
                                                                   double);
 template ulc::Vec3<double> ulc::so3_log(const Eigen::MatrixBase<ulc::Mat3<double>>&);
+template ulc::PairCalibration ulc::calibrate_pair(const std::vector<ulc::PointCloud<float>>&,
+                                                  const std::vector<double>&,
+                                                  const std::vector<ulc::PointCloud<float>>&,
+                                                  const std::vector<double>&,
+                                                  const ulc::CalibrateOptions&);

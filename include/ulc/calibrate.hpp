@@ -1,0 +1,189 @@
+// The calibration pipeline's top floor: one base LiDAR a and one target LiDAR b in, the
+// extrinsic T_base_target out (DESIGN.md, "The house" and "Data flows one way").
+//
+//   frames of a, b -> TERRA(a[i], b[i])              -> R0 (translation zero)
+//                  -> JEEP(pairs from frame i on, R0) -> C1
+// (odometry over all frames, HOTS and time sync come later: a new Stage and a new block in
+// calibrate_pair, each taking the previous stage's extrinsic.)
+//
+// Conventions this header owns (result conventions: calibrate/pair_calibration.hpp):
+//   - Inputs: the frames of each LiDAR (any random-access container of clouds with point traits,
+//     per-point times relative to the frame timestamp) and their timestamps (seconds, each
+//     LiDAR's own clock, one per frame).
+//   - frame_index i: TERRA uses frame i of each LiDAR (the same index, so clock offsets do not
+//     matter); JEEP pairs frames by timestamp from frame i of each on and uses the first
+//     JeepOptions::frames pairs. Frames before i are never touched.
+//   - Stages: any of "terra", "jeep", "terra,jeep" (stages.hpp). TERRA needs no prior and
+//     ignores `initial`; JEEP starts from TERRA's rotation when terra ran, else from `initial`,
+//     which is then required (status initial_required without it).
+//   - Progress: options.progress(stage, fraction in [0, 1]) on the calling thread.
+//   - Threads: TERRA and JEEP are deterministic for any thread count, so is this. Run inside a
+//     tbb::task_arena to limit threads.
+//   - Nothing here throws, exits or prints; it compiles with -fno-exceptions.
+#pragma once
+
+#include <chrono>
+#include <cstddef>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "jeep/jeep.hpp"
+#include "terra/search.hpp"
+#include "ulc/calibrate/frame_range.hpp"
+#include "ulc/calibrate/pair_calibration.hpp"
+#include "ulc/calibrate/stages.hpp"
+#include "ulc/core/point_traits.hpp"
+#include "ulc/core/types.hpp"
+
+namespace ulc {
+
+/// Called with the running stage's name ("terra", "jeep") and its fraction done.
+using CalibrateProgress = std::function<void(const std::string& stage, double fraction)>;
+
+/// Everything calibrate_pair can be told; the defaults are the paper's.
+struct CalibrateOptions {
+  terra::SearchParams terra;  ///< N = 10000, d1 = 20 m, d2 = 5 m, alpha = 2, 10/1 deg strides
+  jeep::JeepOptions jeep;     ///< K = 5 frame pairs, at most 10 rounds
+  std::vector<Stage> stages{Stage::terra, Stage::jeep};
+  std::size_t frame_index = 0;        ///< TERRA's frame, and JEEP's first
+  std::optional<Isometry3d> initial;  ///< T_base_target guess, used when terra does not run
+  CalibrateProgress progress;         ///< optional
+};
+
+namespace calibrate_detail {
+
+inline double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// Statistics of a TERRA search, in the report's form.
+inline TerraReport terra_report(const terra::SearchResult& s, std::size_t frame_index,
+                                std::size_t base_points, std::size_t target_points,
+                                std::size_t lattice_size, double seconds) {
+  TerraReport t;
+  t.status = terra::to_string(s.status);
+  t.reason = s.reason;
+  t.rotation = s.rotation;
+  t.distance = s.distance;
+  t.mask_count = s.mask_count;
+  t.frame_index = frame_index;
+  t.base_points = base_points;
+  t.target_points = target_points;
+  t.lattice_size = lattice_size;
+  t.stats = s.stats;
+  t.seconds = seconds;
+  return t;
+}
+
+inline JeepReport jeep_report(const jeep::JeepResult& j, const Isometry3d& initial,
+                              double seconds) {
+  JeepReport r;
+  r.status = jeep::to_string(j.status);
+  r.reason = j.reason;
+  r.initial = initial;
+  r.extrinsic = j.extrinsic;
+  r.rounds = j.rounds;
+  r.frame_pairs = j.pairs.size();
+  r.calibration_status = ulc::to_string(j.calibration.status);
+  r.final_cost = j.calibration.cost;
+  r.final_inliers = j.calibration.inliers;
+  r.final_rmse = j.calibration.rmse;
+  r.accepted = j.acceptance.accepted;
+  r.overlap = j.acceptance.overlap;
+  r.seconds = seconds;
+  return r;
+}
+
+}  // namespace calibrate_detail
+
+/// Calibrates target LiDAR b against base LiDAR a (see the conventions at the top).
+template <class FramesA, class FramesB>
+PairCalibration calibrate_pair(const FramesA& frames_a, const std::vector<double>& times_a,
+                               const FramesB& frames_b, const std::vector<double>& times_b,
+                               const CalibrateOptions& options = {}) {
+  using calibrate_detail::seconds_since;
+  const auto start = std::chrono::steady_clock::now();
+  PairCalibration r;
+  r.stages = options.stages;
+  auto finish = [&](CalibrateStatus status, std::string reason) {
+    r.status = status;
+    r.success = status == CalibrateStatus::ok;
+    r.reason = std::move(reason);
+    r.timing_s.total = seconds_since(start);
+    return r;
+  };
+  auto report = [&](const char* stage, double fraction) {
+    if (options.progress) options.progress(stage, fraction);
+  };
+
+  if (std::string why = check_stages(options.stages); !why.empty())
+    return finish(CalibrateStatus::invalid_input, "stages: " + why);
+  for (const Stage s : options.stages)
+    if (!stage_available(s))
+      return finish(CalibrateStatus::stage_not_available,
+                    std::string("stage '") + to_string(s) + "' is not available yet");
+  if (frames_a.size() != times_a.size() || frames_b.size() != times_b.size())
+    return finish(CalibrateStatus::invalid_input, "frame and timestamp counts differ");
+  const std::size_t i = options.frame_index;
+  if (i >= frames_a.size() || i >= frames_b.size())
+    return finish(CalibrateStatus::invalid_input,
+                  "frame_index " + std::to_string(i) + " is past the end (base has " +
+                      std::to_string(frames_a.size()) + " frames, target " +
+                      std::to_string(frames_b.size()) + ")");
+  const bool run_terra = has_stage(options.stages, Stage::terra);
+  const bool run_jeep = has_stage(options.stages, Stage::jeep);
+  if (!run_terra && !options.initial)
+    return finish(CalibrateStatus::initial_required,
+                  "stages without terra need an initial extrinsic (TERRA is what finds one "
+                  "without a guess)");
+  if (!run_terra && !options.initial->matrix().allFinite())
+    return finish(CalibrateStatus::invalid_input, "the initial extrinsic is not finite");
+
+  Isometry3d C = run_terra ? Isometry3d::Identity() : *options.initial;
+  r.T_base_target = C;
+
+  if (run_terra) {
+    const auto t0 = std::chrono::steady_clock::now();
+    terra::SearchParams params = options.terra;
+    if (options.progress) params.progress = [&](double f) { report("terra", f); };
+    const auto& a = frames_a[i];
+    const auto& b = frames_b[i];
+    const terra::SearchResult s = terra::estimate_rotation(a, b, params);
+    r.terra = calibrate_detail::terra_report(s, i, traits::size(a), traits::size(b),
+                                             params.lattice_size, seconds_since(t0));
+    r.timing_s.terra = r.terra->seconds;
+    if (!s.ok())
+      return finish(CalibrateStatus::terra_failed,
+                    std::string("TERRA: ") + terra::to_string(s.status) + ": " + s.reason);
+    C = Isometry3d::Identity();
+    C.linear() = s.rotation;
+    r.T_base_target = C;
+  }
+
+  if (run_jeep) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const FrameRange<FramesA> view_a(frames_a, i);
+    const FrameRange<FramesB> view_b(frames_b, i);
+    jeep::ProgressFn progress;
+    if (options.progress)
+      progress = [&](std::size_t done, std::size_t total) {
+        report("jeep", total ? static_cast<double>(done) / static_cast<double>(total) : 1.0);
+      };
+    report("jeep", 0.0);
+    const jeep::JeepResult j = jeep::run_jeep(view_a, times_from(times_a, i), view_b,
+                                              times_from(times_b, i), C, options.jeep, progress);
+    r.jeep = calibrate_detail::jeep_report(j, C, seconds_since(t0));
+    r.timing_s.jeep = r.jeep->seconds;
+    if (!j.ok())
+      return finish(CalibrateStatus::jeep_failed,
+                    std::string("JEEP: ") + jeep::to_string(j.status) + ": " + j.reason);
+    report("jeep", 1.0);
+    C = j.extrinsic;
+    r.T_base_target = C;
+  }
+  return finish(CalibrateStatus::ok, "");
+}
+
+}  // namespace ulc

@@ -1,0 +1,106 @@
+// A PairCalibration as the result file's entry (DESIGN.md, "Result file"; io/result_file.hpp).
+//
+// Conventions this header owns:
+//   - time_offset_s is 0 until the time-sync stage exists (the pipeline assumes synchronised
+//     clocks so far); covariance_6x6 stays null until a stage estimates one.
+//   - "stages" holds one object per stage that ran ("terra", "jeep"); "timing_s" always holds
+//     every stage key of DESIGN.md ("terra", "jeep", "odometry", "hots", "total"), 0 for a
+//     stage that did not run.
+//   - Angles in the stage objects are degrees, distances metres, times seconds.
+// This is an I/O-side header (it builds ulc::io::Json): unlike ulc/calibrate.hpp it is not part
+// of the -fno-exceptions promise.
+#pragma once
+
+#include <string>
+
+#include "ulc/calibrate/pair_calibration.hpp"
+#include "ulc/core/lie.hpp"
+#include "ulc/io/json.hpp"
+#include "ulc/io/json_eigen.hpp"
+#include "ulc/io/result_file.hpp"
+
+namespace ulc {
+
+namespace result_detail {
+
+constexpr double kDegPerRad = 180.0 / 3.14159265358979323846;
+
+inline io::Json stage_stats(const terra::StageStats& s) {
+  io::Json j = io::Json::object();
+  j["rotations"] = s.rotations;
+  j["seconds"] = s.seconds;
+  return j;
+}
+
+}  // namespace result_detail
+
+/// stages.terra: the search's outcome and the statistics a profiler needs.
+inline io::Json terra_to_json(const TerraReport& t) {
+  using result_detail::stage_stats;
+  io::Json j = io::Json::object();
+  j["status"] = t.status;
+  j["reason"] = t.reason;
+  j["frame_index"] = t.frame_index;
+  j["rpy_deg"] = io::vector_to_json(rpy_from_rotation(t.rotation) * result_detail::kDegPerRad);
+  j["distance"] = t.distance;
+  j["mask_count"] = t.mask_count;
+  j["base_points"] = t.base_points;
+  j["target_points"] = t.target_points;
+  j["lattice_size"] = t.lattice_size;
+  j["d1_used_m"] = t.stats.d1_used;
+  j["d1_adapted"] = t.stats.d1_adapted;
+  j["base_cells_beyond_d1"] = t.stats.base_beyond_d1;
+  j["target_cells_beyond_d1"] = t.stats.target_beyond_d1;
+  io::Json stages = io::Json::object();
+  stages["overlap"] = stage_stats(t.stats.overlap);
+  stages["coarse"] = stage_stats(t.stats.coarse);
+  stages["fine"] = stage_stats(t.stats.fine);
+  j["search_stages"] = std::move(stages);
+  j["rotations_evaluated"] = t.stats.rotations();
+  j["descriptor_seconds"] = t.stats.descriptor_seconds;
+  j["seconds"] = t.seconds;
+  return j;
+}
+
+/// stages.jeep: rounds, status and the last calibration phase's cost and inliers.
+inline io::Json jeep_to_json(const JeepReport& r) {
+  io::Json j = io::Json::object();
+  j["status"] = r.status;
+  j["reason"] = r.reason;
+  j["rounds"] = r.rounds;
+  j["frame_pairs"] = r.frame_pairs;
+  j["initial_T_base_target"] = io::matrix_to_json(r.initial.matrix());
+  j["calibration_status"] = r.calibration_status;
+  j["final_cost"] = r.final_cost;
+  j["final_inliers"] = r.final_inliers;
+  j["final_rmse_m"] = r.final_rmse;
+  j["accepted"] = r.accepted;
+  j["overlap"] = r.overlap;
+  j["seconds"] = r.seconds;
+  return j;
+}
+
+/// The result-file entry for target `target` against base `base`.
+inline io::PairResult to_pair_result(const PairCalibration& c, const std::string& base,
+                                     const std::string& target) {
+  io::PairResult r;
+  r.base = base;
+  r.target = target;
+  r.success = c.success;
+  r.status = to_string(c.status);
+  r.reason = c.reason;
+  r.T_base_target = c.T_base_target;
+  r.time_offset_s = 0.0;
+  r.stages = io::Json::object();
+  if (c.terra) r.stages["terra"] = terra_to_json(*c.terra);
+  if (c.jeep) r.stages["jeep"] = jeep_to_json(*c.jeep);
+  r.timing_s = io::Json::object();
+  r.timing_s["terra"] = c.timing_s.terra;
+  r.timing_s["jeep"] = c.timing_s.jeep;
+  r.timing_s["odometry"] = 0.0;
+  r.timing_s["hots"] = 0.0;
+  r.timing_s["total"] = c.timing_s.total;
+  return r;
+}
+
+}  // namespace ulc

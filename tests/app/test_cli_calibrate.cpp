@@ -1,0 +1,262 @@
+// `ulc calibrate` end to end: on a tiny simulated 64-32 dataset (written by `ulc simulate`),
+// --stages terra writes the result file of DESIGN.md with a rotation near the ground truth;
+// terra,jeep passes `ulc evaluate`; jeep alone takes --initial as numbers or as a result file;
+// a target that cannot be calibrated gives exit code 1 and still its entry; bad usage gives exit
+// code 2 and one line naming the problem; and on the real croon_0003 sample TERRA finds both
+// side LiDARs within 5 deg of the shipped calibration.
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "run_command.hpp"
+#include "test_paths.hpp"
+#include "ulc/core/lie.hpp"
+#include "ulc/core/pose_error.hpp"
+#include "ulc/io/ground_truth.hpp"
+#include "ulc/io/pcd.hpp"
+#include "ulc/io/result_file.hpp"
+
+namespace fs = std::filesystem;
+using ulc_test::quote;
+using ulc_test::run_command;
+
+namespace {
+
+const std::string kUlc = ULC_APP_PATH;
+constexpr double kDeg = 3.14159265358979323846 / 180.0;
+
+/// A 0.6 s 64-32 drive (six frames per LiDAR) in its own temporary folder, removed afterwards.
+struct Dataset {
+  fs::path dir;
+  explicit Dataset(const std::string& name) : dir(fs::temp_directory_path() / name) {
+    fs::remove_all(dir);
+    const auto run = run_command(kUlc + " simulate --quiet --scenario 64-32 --seconds 0.6 " +
+                                 "--seed 2 --out " + quote(dir.string()));
+    INFO(run.output);
+    REQUIRE(run.exit_code == 0);
+  }
+  ~Dataset() { fs::remove_all(dir); }
+  std::string lidar(const std::string& name) const { return quote((dir / name).string()); }
+  std::string file(const std::string& name) const { return (dir / name).string(); }
+  std::string pair_args() const {
+    return " --base " + lidar("lidar64") + " --target " + lidar("lidar32");
+  }
+  ulc::io::GroundTruth truth() const {
+    return ulc::io::read_ground_truth((dir / "ground_truth.json").string());
+  }
+};
+
+Eigen::Isometry3d true_extrinsic(const Dataset& d) {
+  const auto gt = d.truth();
+  const auto* p = gt.find_pair("lidar64", "lidar32");
+  REQUIRE(p);
+  return p->T_base_target;
+}
+
+/// "x y z roll pitch yaw" (metres, degrees) of T, as --initial takes it.
+std::string xyz_rpy(const Eigen::Isometry3d& T) {
+  const Eigen::Vector3d t = T.translation();
+  const Eigen::Vector3d rpy = ulc::rpy_from_rotation(T.linear()) / kDeg;
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "%.9f %.9f %.9f %.9f %.9f %.9f", t.x(), t.y(), t.z(), rpy.x(),
+                rpy.y(), rpy.z());
+  return buf;
+}
+
+/// `ulc evaluate --json` of a result file: the first pair's success.
+bool evaluate_success(const Dataset& d, const std::string& result) {
+  const auto run = run_command(kUlc + " evaluate --json --result " + quote(result) +
+                               " --ground-truth " + quote(d.file("ground_truth.json")));
+  INFO(run.output);
+  const auto doc = ulc::io::parse_json(run.output);
+  return run.exit_code == 0 && doc.at("pairs")[0].at("success").as_bool();
+}
+
+}  // namespace
+
+TEST_CASE("ulc calibrate --stages terra writes the result file of DESIGN.md", "[app][calibrate]") {
+  const Dataset d("ulc_test_calibrate_terra");
+  const std::string out = d.file("result.json");
+  const auto run = run_command(kUlc + " calibrate" + d.pair_args() +
+                               " --stages terra --frame-index 1 --output " + quote(out));
+  INFO(run.output);
+  REQUIRE(run.exit_code == 0);
+  CHECK_THAT(run.output, Catch::Contains("lidar64 <- lidar32: ok"));
+  CHECK_THAT(run.output, Catch::Contains("lidar32 terra: 100%"));  // plain progress when piped
+
+  const auto results = ulc::io::read_result_file(out);
+  REQUIRE(results.size() == 1);
+  const auto& r = results[0];
+  CHECK(r.base == "lidar64");
+  CHECK(r.target == "lidar32");
+  CHECK(r.success);
+  CHECK(r.status == "ok");
+  CHECK(r.T_base_target.translation() == Eigen::Vector3d::Zero());
+  const auto e = ulc::pose_error(true_extrinsic(d), r.T_base_target);
+  INFO("e_rot " << e.rotation_deg << " deg");
+  CHECK(ulc::is_rotation_init_success(e));
+
+  // Every field of DESIGN.md, in its spelling.
+  const auto doc = ulc::io::read_json_file(out);
+  const auto& entry = doc.at("results")[0];
+  for (const char* key :
+       {"base", "target", "success", "status", "reason", "T_base_target", "translation_m",
+        "rotation_quat_wxyz", "rpy_deg", "time_offset_s", "covariance_6x6", "stages", "timing_s"})
+    CHECK(entry.find(key) != nullptr);
+  CHECK(entry.at("translation_m").size() == 3);
+  CHECK(entry.at("rotation_quat_wxyz").size() == 4);
+  CHECK(entry.at("rpy_deg").size() == 3);
+  const auto& terra = entry.at("stages").at("terra");
+  CHECK(terra.at("status").as_string() == "ok");
+  CHECK(terra.at("frame_index").as_number() == 1);
+  CHECK(terra.at("rotations_evaluated").as_number() > 1000);
+  CHECK(terra.at("d1_used_m").as_number() > 0);
+  CHECK(entry.at("stages").find("jeep") == nullptr);
+  for (const char* key : {"terra", "jeep", "odometry", "hots", "total"})
+    CHECK(entry.at("timing_s").at(key).is_number());
+}
+
+TEST_CASE("ulc calibrate terra,jeep passes ulc evaluate", "[app][calibrate]") {
+  const Dataset d("ulc_test_calibrate_full");
+  const std::string out = d.file("result.json");
+  const auto run = run_command(kUlc + " calibrate" + d.pair_args() +
+                               " --stages terra,jeep --threads 2 --output " + quote(out));
+  INFO(run.output);
+  REQUIRE(run.exit_code == 0);
+  const auto r = ulc::io::read_result_file(out);
+  REQUIRE(r.size() == 1);
+  CHECK(r[0].stages.at("jeep").at("status").as_string() == "ok");
+  CHECK(r[0].stages.at("jeep").at("frame_pairs").as_number() == 5);
+  CHECK(evaluate_success(d, out));
+}
+
+TEST_CASE("ulc calibrate --stages jeep takes --initial as numbers or a result file",
+          "[app][calibrate]") {
+  const Dataset d("ulc_test_calibrate_initial");
+  // 3 deg and 0.5 m off the truth, written in metres and degrees.
+  Eigen::Isometry3d guess = true_extrinsic(d);
+  guess.linear() = guess.linear() * ulc::rotation_from_rpy(2.0 * kDeg, -2.0 * kDeg, 1.0 * kDeg);
+  guess.translation() += Eigen::Vector3d(0.3, -0.3, 0.25);
+  const std::string numbers = d.file("from_numbers.json");
+  const auto run = run_command(kUlc + " calibrate --quiet" + d.pair_args() +
+                               " --stages jeep --frames 4 --initial " + quote(xyz_rpy(guess)) +
+                               " --output " + quote(numbers));
+  INFO(run.output);
+  REQUIRE(run.exit_code == 0);
+  const auto r = ulc::io::read_result_file(numbers);
+  REQUIRE(r.size() == 1);
+  CHECK(r[0].stages.find("terra") == nullptr);
+  CHECK(r[0].stages.at("jeep").at("frame_pairs").as_number() == 4);
+  // JEEP started from the guess as typed (to the 1e-9 printed digits).
+  const auto start = ulc::io::json_to_isometry(r[0].stages.at("jeep").at("initial_T_base_target"),
+                                               numbers, "initial");
+  CHECK(ulc::pose_error(guess, start).rotation_deg < 1e-6);
+  CHECK(ulc::pose_error(guess, start).translation_m < 1e-6);
+  CHECK(evaluate_success(d, numbers));
+
+  // A result file as the guess: a terra-only result (rotation, zero translation) for the pair.
+  ulc::io::PairResult seed;
+  seed.base = "lidar64";
+  seed.target = "lidar32";
+  seed.T_base_target = guess;
+  ulc::io::write_result_file(d.file("seed.json"), {seed});
+  const std::string from_file = d.file("from_file.json");
+  const auto again = run_command(kUlc + " calibrate --quiet" + d.pair_args() +
+                                 " --stages jeep --frames 4 --initial " +
+                                 quote(d.file("seed.json")) + " --output " + quote(from_file));
+  INFO(again.output);
+  REQUIRE(again.exit_code == 0);
+  const auto r2 = ulc::io::read_result_file(from_file);
+  REQUIRE(r2.size() == 1);
+  // The same guess gives the same run, to the digits the first guess was printed with.
+  CHECK(ulc::pose_error(r[0].T_base_target, r2[0].T_base_target).rotation_deg < 1e-3);
+  CHECK(evaluate_success(d, from_file));
+}
+
+TEST_CASE("a target that cannot be calibrated: exit code 1, and its entry says why",
+          "[app][calibrate]") {
+  const Dataset d("ulc_test_calibrate_fail");
+  // A target that sees only a wall 1.5 m away: TERRA has nothing beyond d1 to compare.
+  std::vector<Eigen::Vector3f> wall;
+  for (int i = -30; i <= 30; ++i)
+    for (int j = -30; j <= 30; ++j) wall.emplace_back(1.5f, 0.05f * i, 0.05f * j);
+  ulc::io::write_pcd(d.file("wall.pcd"), wall);
+  const std::string out = d.file("result.json");
+  const auto run = run_command(kUlc + " calibrate --stages terra --base " + d.lidar("lidar64") +
+                               " --target " + d.lidar("lidar32") + " --target " +
+                               quote(d.file("wall.pcd")) + " --output " + quote(out));
+  INFO(run.output);
+  CHECK(run.exit_code == 1);
+  CHECK_THAT(run.output, Catch::Contains("lidar64 <- wall: terra_failed"));
+  const auto r = ulc::io::read_result_file(out);
+  REQUIRE(r.size() == 2);
+  CHECK(r[0].success);
+  CHECK(r[1].target == "wall");  // a single frame file is named by its stem
+  CHECK_FALSE(r[1].success);
+  CHECK(r[1].status == "terra_failed");
+  CHECK_THAT(r[1].reason, Catch::Contains("no_overlap"));
+}
+
+TEST_CASE("ulc calibrate reports bad usage and unreadable input with exit code 2",
+          "[app][calibrate][usage]") {
+  const Dataset d("ulc_test_calibrate_usage");
+  auto usage = [&](const std::string& args, const std::string& message) {
+    const auto run = run_command(kUlc + " calibrate " + args);
+    INFO(args << "\n" << run.output);
+    CHECK(run.exit_code == 2);
+    CHECK_THAT(run.output, Catch::Contains(message));
+    // One line: the problem, nothing else.
+    CHECK(std::count(run.output.begin(), run.output.end(), '\n') == 1);
+  };
+  const std::string missing = d.file("no_such_lidar");
+  usage("--base " + quote(missing) + " --target " + d.lidar("lidar32"),
+        missing + ": no such folder or file");
+  usage(d.pair_args() + " --stages jeep --initial '1 2 3'",
+        "'--initial' expects \"x y z roll pitch yaw\"");
+  usage(d.pair_args() + " --stages jeep --initial '1 2 3 4 5 six'", "got '1 2 3 4 5 six'");
+  usage(d.pair_args() + " --stages jeep --initial " + quote(d.file("missing.json")),
+        "missing.json: cannot open file");
+  usage(d.pair_args() + " --stages terra,icp", "unknown stage 'icp'");
+  usage(d.pair_args() + " --stages jeep,terra", "cannot follow");
+  usage(d.pair_args() + " --stages terra,jeep,hots", "stage 'hots' is not available yet");
+  usage(d.pair_args() + " --stages jeep", "needs an initial extrinsic");
+  usage(d.pair_args() + " --stages terra --initial '0 0 0 0 0 0'", "'--initial' is only used");
+  usage(d.pair_args() + " --frame-index 6", "--frame-index 6 is past the end of");
+  usage(d.pair_args() + " --frame-index -1", "'--frame-index' must be within");
+  usage(d.pair_args() + " --frames 0", "'--frames' must be within");
+  usage(d.pair_args() + " --threads 0", "'--threads' must be within");
+  usage(d.pair_args() + " --output " + quote(d.file("nowhere/result.json")),
+        "nowhere/result.json: no such folder");
+  usage("--target " + d.lidar("lidar32"), "missing required option '--base");
+  usage("--base " + d.lidar("lidar64"), "missing required option '--target");
+  const auto help = run_command(kUlc + " calibrate --help");
+  CHECK(help.exit_code == 0);
+  CHECK_THAT(help.output, Catch::Contains("--initial") && Catch::Contains("--frame-index"));
+}
+
+TEST_CASE("real sample: TERRA finds both side LiDARs of croon_0003 with no guess",
+          "[app][calibrate][real]") {
+  const auto dir = ulc_test::croon_dir();
+  ULC_SKIP_UNLESS(!dir.empty(), "croon_0003 sample not found next to the checkout");
+  const fs::path out = fs::temp_directory_path() / "ulc_test_calibrate_croon.json";
+  const auto run = run_command(
+      kUlc + " calibrate --quiet --stages terra --base " + quote((dir / "top.pcd").string()) +
+      " --target " + quote((dir / "left.pcd").string()) + " --target " +
+      quote((dir / "right.pcd").string()) + " --output " + quote(out.string()));
+  INFO(run.output);
+  REQUIRE(run.exit_code == 0);
+  const auto results = ulc::io::read_result_file(out.string());
+  fs::remove(out);
+  const auto gt = ulc::io::read_ground_truth((dir / "ground_truth.json").string());
+  REQUIRE(results.size() == 2);
+  for (const auto& r : results) {
+    const auto* truth = gt.find_pair(r.base, r.target);
+    REQUIRE(truth);
+    const auto e = ulc::pose_error(truth->T_base_target, r.T_base_target);
+    INFO(r.base << " <- " << r.target << ": e_rot " << e.rotation_deg << " deg");
+    CHECK(e.rotation_deg < 5.0);
+  }
+}

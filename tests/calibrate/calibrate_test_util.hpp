@@ -1,0 +1,70 @@
+// Helpers of the pipeline tests: a short simulated 64-32 drive held in memory (decimated so the
+// tests stay fast), the paper's disturbance of a ground truth, and exact bit comparison.
+#pragma once
+
+#include <Eigen/Core>
+#include <cmath>
+#include <cstring>
+#include <random>
+#include <vector>
+
+#include "ulc/core/lie.hpp"
+#include "ulc/core/types.hpp"
+#include "ulc/sim/simulate.hpp"
+
+namespace calibrate_test {
+
+constexpr double kDeg = 3.14159265358979323846 / 180.0;
+
+/// Six frames of each LiDAR of the 64-32 rig, the first 0.6 s of the town drive.
+inline const ulc::sim::Dataset& drive_64_32() {
+  static const ulc::sim::Dataset d = [] {
+    ulc::sim::SimulationOptions o;
+    o.seconds = 0.6;
+    o.seed = 1;
+    o.decimation = 2;
+    return ulc::sim::simulate(*ulc::sim::scenario("64-32"), o).dataset;
+  }();
+  return d;
+}
+
+/// The same frames as std::vector<Eigen::Vector3d> (double, no per-point times).
+inline std::vector<std::vector<Eigen::Vector3d>> as_vectors(
+    const std::vector<ulc::PointCloud<float>>& frames) {
+  std::vector<std::vector<Eigen::Vector3d>> out;
+  for (const auto& f : frames) {
+    out.emplace_back();
+    for (const auto& p : f.points) out.back().push_back(p.cast<double>());
+  }
+  return out;
+}
+
+/// The same frames as ulc::PointCloud<double>, per-point times kept.
+inline std::vector<ulc::PointCloud<double>> as_double_clouds(
+    const std::vector<ulc::PointCloud<float>>& frames) {
+  std::vector<ulc::PointCloud<double>> out(frames.size());
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    for (const auto& p : frames[k].points) out[k].points.push_back(p.cast<double>());
+    out[k].times = frames[k].times;
+  }
+  return out;
+}
+
+/// The paper's disturbance: `angle` about a random axis, `distance` in a random direction.
+inline ulc::Isometry3d disturbed(const ulc::Isometry3d& truth, std::uint64_t seed, double angle_rad,
+                                 double distance_m) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  const ulc::Vec3d axis = ulc::Vec3d(gauss(rng), gauss(rng), gauss(rng)).normalized();
+  const ulc::Vec3d dir = ulc::Vec3d(gauss(rng), gauss(rng), gauss(rng)).normalized();
+  ulc::Isometry3d out = truth;
+  out.linear() = truth.linear() * ulc::so3_exp(ulc::Vec3d(angle_rad * axis));
+  out.translation() = truth.translation() + distance_m * dir;
+  return out;
+}
+
+inline bool same_bits(const ulc::Isometry3d& a, const ulc::Isometry3d& b) {
+  return std::memcmp(a.matrix().data(), b.matrix().data(), 16 * sizeof(double)) == 0;
+}
+
+}  // namespace calibrate_test
