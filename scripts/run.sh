@@ -13,7 +13,14 @@ out=${ULC_OUT:-/tmp/ulc_demo}
 $ulc simulate --scenario 64-32 --seconds 3 --seed 1 --out "$out/64-32" --preview "$out/64-32.png"
 $ulc inspect "$out/64-32/lidar64"
 $ulc inspect "$out/64-32/lidar32"
+# Calibrate with no initial guess (TERRA, then JEEP) and compare with the ground truth.
+$ulc calibrate --base "$out/64-32/lidar64" --target "$out/64-32/lidar32" \
+  --output "$out/64-32/result.json" --quiet
+$ulc evaluate --result "$out/64-32/result.json" --ground-truth "$out/64-32/ground_truth.json"
 sample=../shared/data/real/croon_0003
 if [ -d "$sample" ]; then
-  $ulc inspect "$sample/top.pcd"
+  # The real single-frame rig: rotations only (TERRA), checked against the shipped ones.
+  $ulc calibrate --base "$sample/top.pcd" --target "$sample/left.pcd" --target "$sample/right.pcd" \
+    --stages terra --output "$out/croon_0003.json" --quiet
+  $ulc evaluate --result "$out/croon_0003.json" --ground-truth "$sample/ground_truth.json" || true
 fi
