@@ -4,8 +4,8 @@
 //   bench_jeep [--repeats N] [--threads N] [--json]          (d) registration speed
 //   bench_jeep --accuracy   [--scenarios LIST] [--starts 50] [--frames 5] [--seed 1]
 //   bench_jeep --separation [--scenarios LIST] [--starts 10]
-//   bench_jeep --robustness [--scenarios 64-32,64-horizon] [--starts 3]
-//   bench_jeep --frames-sweep [--scenarios 64-32,64-horizon,64-tele] [--starts 5]
+//   bench_jeep --robustness [--scenarios 64-32,64-horizon] [--starts 3] [--png DIR]
+//   bench_jeep --frames-sweep [--scenarios 64-32,64-horizon,64-tele] [--starts 5] [--png DIR]
 //   bench_jeep --odometry   [--seconds 20] [--repeats 1]
 //   common: [--seconds 20] [--seed 1] [--threads 2] [--cache DIR] [--json]
 //
@@ -42,6 +42,7 @@
 #include "jeep/run_odometry.hpp"
 #include "jeep/scan_scan.hpp"
 #include "support/bench_util.hpp"
+#include "support/heatmap_png.hpp"
 #include "ulc/core/pose_error.hpp"
 #include "ulc/core/registration_target.hpp"
 
@@ -62,6 +63,7 @@ struct Config {
   std::uint64_t seed = 1;
   int threads = 2;
   std::string cache = "/tmp/ulc_jeep_cache";
+  std::string png_dir;  ///< --png DIR: robustness and frames-sweep heat maps as PNG
   ulc_bench::Options bench;
 };
 
@@ -334,11 +336,31 @@ void separation(Config c) {
         {"starts", Cell::integer(static_cast<long long>(c.starts))},
         {"frames", Cell::integer(static_cast<long long>(c.frames))}},
        {{"overlap", "agreeing / near points of map b (acceptance.hpp); settled runs only"},
-        {"rule", "accept iff overlap >= 0.7 and condition >= 1e-3"}});
+        {"rule",
+         "accept iff overlap >= " + std::to_string(jeep::AcceptanceOptions{}.min_overlap) +
+             " and condition >= " + std::to_string(jeep::AcceptanceOptions{}.min_condition)}});
 }
 
 // ---------------------------------------------------------------------------------------------
 // (b) robustness
+
+std::string format_fixed(double v, int decimals) {
+  std::ostringstream out;
+  out.setf(std::ios::fixed);
+  out.precision(decimals);
+  out << v;
+  return out.str();
+}
+
+/// With --png DIR, the heat map goes to DIR/name (a failure is reported, not fatal).
+void write_png(const Config& c, const std::string& name, const ulc_bench::Heatmap& map) {
+  if (c.png_dir.empty()) return;
+  const std::string path = c.png_dir + "/" + name;
+  if (ulc_bench::write_heatmap_png(path, map))
+    std::cerr << "bench_jeep: wrote " << path << "\n";
+  else
+    std::cerr << "bench_jeep: could not write " << path << "\n";
+}
 
 void robustness(Config c) {
   if (c.scenarios.empty()) c.scenarios = {"64-32", "64-horizon"};
@@ -349,13 +371,18 @@ void robustness(Config c) {
   o.frames = c.frames;
   for (const auto& scenario : c.scenarios) {
     const Drive d = load_drive(scenario, c);
+    ulc_bench::Heatmap map;  // rows: rotation disturbance, columns: translation disturbance
     for (int ri = 0; ri < 6; ++ri) {
+      map.row_labels.push_back(format_fixed(2.5 * ri, 1));
+      map.column_labels.push_back(format_fixed(1.0 * ri, 0));
+      map.values.emplace_back();
       for (int ti = 0; ti < 6; ++ti) {
         const double deg = 2.5 * ri, metres = 1.0 * ti;
         Summary sum;
         for (std::size_t s : start_pairs(d, c.starts, c.frames))
           sum.add(run_jeep(window(d, s, c.frames), disturbance_for(d, c, s, deg, metres, 17),
                            d.truth, o, c.threads));
+        map.values.back().push_back(sum.pct(sum.successes));
         table.add_row({scenario, Cell::num(deg, 1), Cell::num(metres, 1),
                        Cell::integer(static_cast<long long>(sum.runs)),
                        Cell::num(sum.pct(sum.successes), 1),
@@ -366,6 +393,7 @@ void robustness(Config c) {
                     << " m: " << sum.pct(sum.successes) << "%\n";
       }
     }
+    write_png(c, "jeep_robustness_" + scenario + ".png", map);
   }
   emit(table, "bench_jeep_robustness", c,
        {{"scenarios", scenario_list(c)},
@@ -378,8 +406,12 @@ void frames_sweep(Config c) {
   if (!c.starts) c.starts = 5;
   ulc_bench::Table table({"scenario", "frames", "runs", "success_pct", "median_e_rot_deg",
                           "median_e_trans_cm", "median_time_s"});
+  ulc_bench::Heatmap map;  // rows: scenarios, columns: K
+  for (std::size_t K = 2; K <= 12; ++K) map.column_labels.push_back(std::to_string(K));
   for (const auto& scenario : c.scenarios) {
     const Drive d = load_drive(scenario, c);
+    map.row_labels.push_back(std::to_string(map.row_labels.size() + 1));
+    map.values.emplace_back();
     for (std::size_t K = 2; K <= 12; ++K) {
       jeep::JeepOptions o;
       o.frames = K;
@@ -387,6 +419,7 @@ void frames_sweep(Config c) {
       for (std::size_t s : start_pairs(d, c.starts, 12))
         sum.add(
             run_jeep(window(d, s, K), disturbance_for(d, c, s, 5.0, 2.0), d.truth, o, c.threads));
+      map.values.back().push_back(sum.pct(sum.successes));
       table.add_row({scenario, Cell::integer(static_cast<long long>(K)),
                      Cell::integer(static_cast<long long>(sum.runs)),
                      Cell::num(sum.pct(sum.successes), 1), Cell::num(jeep_test::median(sum.rot), 4),
@@ -396,6 +429,7 @@ void frames_sweep(Config c) {
         std::cerr << "  " << scenario << " K " << K << ": " << sum.pct(sum.successes) << "%\n";
     }
   }
+  write_png(c, "jeep_frames.png", map);
   emit(table, "bench_jeep_frames", c,
        {{"scenarios", scenario_list(c)},
         {"starts", Cell::integer(static_cast<long long>(c.starts))},
@@ -579,6 +613,8 @@ int main(int argc, char** argv) {
       c.threads = std::max(1, std::atoi(argv[++i]));
     } else if (a == "--cache" && value) {
       c.cache = argv[++i];
+    } else if (a == "--png" && value) {
+      c.png_dir = argv[++i];
     } else {
       rest.push_back(argv[i]);
     }
