@@ -1,5 +1,6 @@
 // Compiled with -fno-exceptions: every algorithm header must build this way (DESIGN.md).
 // Add each new algorithm header here.
+#include "hots/hots.hpp"
 #include "jeep/jeep.hpp"
 #include "jeep/run_odometry.hpp"
 #include "jeep/scan_scan.hpp"

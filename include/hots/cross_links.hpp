@@ -1,0 +1,120 @@
+// Cross-LiDAR links: the two hierarchies (hierarchy.hpp) are tied by registering, at every
+// layer, each submap of LiDAR b to the submap of LiDAR a nearest in time (paper Sec. "Pose
+// Refinement by Hierarchical Optimization": "linked through the registration of different
+// layer submaps"), starting from their current poses, i.e. through the current extrinsic.
+//
+// Conventions this header owns:
+//   - Both LiDARs' poses are T_world_frame in ONE world frame. A member's time is its anchor
+//     frame's timestamp; b's times are moved to a's clock with t_a = t_b + time_offset_s.
+//   - The registration (ulc point_to_plane, coarse to fine) estimates Z = T_anchor_a^-1
+//     T_anchor_b: source = b's member cloud, target = a's member cloud with per-point planes.
+//     Its information is the registration's Hessian (left perturbation in a's anchor frame,
+//     exactly the pose-graph residual's tangent) over sigma^2, sigma = max(rmse, min_sigma).
+//   - A link is kept when the registration is ok and its inlier ratio >= min_inlier_ratio.
+//   - Registrations run as TBB tasks, one slot each; the kept links are in (layer, a member)
+//     order. Nothing here throws or prints.
+#pragma once
+
+#include <cmath>
+#include <cstddef>
+#include <vector>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "hots/hierarchy.hpp"
+#include "ulc/core/point_to_plane.hpp"
+#include "ulc/core/registration_target.hpp"
+
+namespace hots {
+
+struct CrossLinkOptions {
+  int min_layer = 0;              ///< layers min_layer .. top are linked
+  std::size_t layer0_stride = 1;  ///< at layer 0, every n-th a frame
+  double gate = 1.0;              ///< first registration stage's gate, m
+  double min_inlier_ratio = 0.3;
+  double min_sigma = 0.01;  ///< m
+  ulc::PlaneCloudOptions planes;
+};
+
+struct CrossLink {
+  std::size_t frame_a = 0, frame_b = 0;  ///< anchor frames
+  Isometry3d measured = Isometry3d::Identity();
+  Mat6d information = Mat6d::Zero();
+  int layer = 0;
+  double rmse = 0.0;
+};
+
+struct CrossLinkStats {
+  std::size_t attempted = 0;
+  std::size_t kept = 0;
+};
+
+namespace cross_link_detail {
+
+inline std::size_t nearest(const std::vector<double>& member_times, double t) {
+  std::size_t best = 0;
+  for (std::size_t i = 1; i < member_times.size(); ++i)
+    if (std::abs(member_times[i] - t) < std::abs(member_times[best] - t)) best = i;
+  return best;
+}
+
+}  // namespace cross_link_detail
+
+template <typename S>
+std::vector<CrossLink> cross_links(
+    const HierarchyResult<S>& ha, const std::vector<std::vector<ulc::Vec3<S>>>& frames_a,
+    const std::vector<double>& times_a, const std::vector<Isometry3d>& poses_a,
+    const HierarchyResult<S>& hb, const std::vector<std::vector<ulc::Vec3<S>>>& frames_b,
+    const std::vector<double>& times_b, const std::vector<Isometry3d>& poses_b,
+    double time_offset_s, const CrossLinkOptions& options, CrossLinkStats* stats = nullptr) {
+  std::vector<CrossLink> links;
+  const std::size_t layers = std::min(ha.members.size(), hb.members.size());
+  const auto stages = ulc::coarse_to_fine_stages(options.gate);
+  for (std::size_t l = static_cast<std::size_t>(std::max(options.min_layer, 0)); l < layers; ++l) {
+    const auto& ma = ha.members[l];
+    const auto& mb = hb.members[l];
+    if (ma.empty() || mb.empty()) continue;
+    std::vector<double> tb;
+    for (const auto& m : mb) tb.push_back(times_b[m.begin] + time_offset_s);
+    std::vector<std::size_t> chosen;
+    const std::size_t stride = l == 0 ? std::max<std::size_t>(options.layer0_stride, 1) : 1;
+    for (std::size_t i = 0; i < ma.size(); i += stride) chosen.push_back(i);
+    std::vector<CrossLink> slot(chosen.size());
+    std::vector<char> keep(chosen.size(), 0);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chosen.size(), 1),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        for (std::size_t c = r.begin(); c != r.end(); ++c) {
+                          const auto& a = ma[chosen[c]];
+                          const auto& b = mb[cross_link_detail::nearest(tb, times_a[a.begin])];
+                          const auto& cloud_a = l == 0 ? frames_a[a.begin] : a.cloud;
+                          const auto& cloud_b = l == 0 ? frames_b[b.begin] : b.cloud;
+                          if (cloud_a.empty() || cloud_b.empty()) continue;
+                          const ulc::PlaneCloud<S> target(cloud_a, options.planes);
+                          if (target.empty()) continue;
+                          const Isometry3d initial = poses_a[a.begin].inverse() * poses_b[b.begin];
+                          const auto reg =
+                              ulc::register_point_to_plane(cloud_b, target, initial, stages);
+                          if (!reg.ok() || reg.inlier_ratio() < options.min_inlier_ratio) continue;
+                          CrossLink& link = slot[c];
+                          link.frame_a = a.begin;
+                          link.frame_b = b.begin;
+                          link.measured = reg.pose.template cast<double>();
+                          const double sigma = std::max(reg.rmse, options.min_sigma);
+                          link.information = reg.hessian / (sigma * sigma);
+                          link.layer = static_cast<int>(l);
+                          link.rmse = reg.rmse;
+                          keep[c] = 1;
+                        }
+                      });
+    for (std::size_t c = 0; c < chosen.size(); ++c) {
+      if (stats) ++stats->attempted;
+      if (!keep[c]) continue;
+      if (stats) ++stats->kept;
+      links.push_back(slot[c]);
+    }
+  }
+  return links;
+}
+
+}  // namespace hots

@@ -1,0 +1,198 @@
+// The hierarchy of one LiDAR (paper Sec. "Pose Refinement by Hierarchical Optimization", after
+// HBA): frames are grouped in windows of w; each window's BA (window_ba.hpp) refines its frames
+// relative to its first one, and the window's frames, merged in the first frame's coordinates,
+// become one frame (a submap) of the next layer. Layers repeat up to `layers`.
+//
+// Conventions this header owns:
+//   - Input: one cloud per frame (points in the frame's body frame, already deskewed) and
+//     T_world_frame per frame. Members of layer l are layer-0 frames' subtrees: member k of layer
+//     l covers the contiguous frames [begin, end) and is ANCHORED at frame `begin`: its pose is
+//     that frame's pose, its cloud is the subtree's points in that frame's coordinates. So a
+//     submap needs no variable of its own in the pose graph; its factors tie anchor frames.
+//   - Windows are consecutive runs of w members (the last run may be shorter; a run of one is
+//     carried up unchanged). Windows of a layer run as TBB tasks, each into its own slot.
+//   - After a window's BA, every frame of member k's subtree moves with it:
+//     T <- T_k,new T_k,old^-1 T. `poses` holds the result of all layers.
+//   - Each window with a usable BA yields one relative-pose factor per member k >= 1: from the
+//     anchor of member 0 to the anchor of member k, Z = T_0^-1 T_k, information = the inverse of
+//     the k-th 6x6 block of (H / (2 sigma^2))^-1 (H the BA Hessian without the gauge block,
+//     sigma^2 its noise estimate), i.e. the marginal information of that relative pose.
+//   - Submap clouds are voxel-downsampled (submap_voxel) to bound the upper layers' work.
+//   - Nothing here throws or prints; the same results for any number of threads.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <vector>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "hots/pose_graph.hpp"
+#include "hots/window_ba.hpp"
+#include "ulc/core/point_cloud.hpp"
+#include "ulc/core/voxel_downsample.hpp"
+
+namespace hots {
+
+struct HierarchyOptions {
+  std::size_t window = 5;
+  int layers = 3;
+  WindowBaOptions ba;
+  double submap_voxel = 0.1;  ///< m
+  /// Floor of the BA noise estimate (m): a near-perfect window does not dominate the graph.
+  double min_sigma = 1e-3;
+};
+
+/// A relative-pose factor between two layer-0 frames, from a window's BA.
+struct HierarchyFactor {
+  std::size_t from = 0;  ///< anchor frame of the window's first member
+  std::size_t to = 0;    ///< anchor frame of member k
+  Isometry3d measured = Isometry3d::Identity();
+  Mat6d information = Mat6d::Zero();
+  int layer = 0;
+};
+
+/// One member of a layer: a subtree of frames, anchored at its first frame.
+template <typename S>
+struct HierarchyMember {
+  std::size_t begin = 0, end = 0;   ///< layer-0 frames [begin, end); the anchor is `begin`
+  std::vector<ulc::Vec3<S>> cloud;  ///< in the anchor's coordinates (empty at layer 0)
+};
+
+template <typename S>
+struct HierarchyResult {
+  std::vector<Isometry3d> poses;  ///< T_world_frame after all layers
+  std::vector<HierarchyFactor> factors;
+  /// members[l] = layer l's members (layer 0: one per frame, clouds not copied).
+  std::vector<std::vector<HierarchyMember<S>>> members;
+  std::size_t windows = 0;
+  std::size_t failed_windows = 0;  ///< BA unusable: no factor, poses unchanged
+  std::size_t planes = 0;          ///< over all windows
+};
+
+namespace hierarchy_detail {
+
+/// Marginal information of each member k >= 1's relative pose from a window's BA.
+inline std::vector<Mat6d> marginal_information(const WindowBaResult& ba, double min_sigma) {
+  const Eigen::Index n = ba.hessian.rows();
+  std::vector<Mat6d> out;
+  if (n < 12) return out;
+  const double sigma_sq = std::max(ba.noise_variance, min_sigma * min_sigma);
+  const Eigen::MatrixXd H = ba.hessian.bottomRightCorner(n - 6, n - 6) / (2.0 * sigma_sq);
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(0.5 * (H + H.transpose()));
+  if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0.0)) return out;
+  const Eigen::MatrixXd cov = ldlt.solve(Eigen::MatrixXd::Identity(n - 6, n - 6));
+  if (!cov.allFinite()) return out;
+  for (Eigen::Index k = 0; k + 6 <= n - 6; k += 6) {
+    const Mat6d block = cov.block<6, 6>(k, k);
+    const Eigen::LDLT<Mat6d> inv(0.5 * (block + block.transpose()));
+    if (inv.info() != Eigen::Success || !(inv.vectorD().minCoeff() > 0.0)) return {};
+    Mat6d info = inv.solve(Mat6d::Identity());
+    out.push_back(0.5 * (info + info.transpose()));
+  }
+  return out;
+}
+
+}  // namespace hierarchy_detail
+
+/// Builds and optimises the hierarchy of one LiDAR (see the header comment).
+template <typename S>
+HierarchyResult<S> build_hierarchy(const std::vector<std::vector<ulc::Vec3<S>>>& frames,
+                                   const std::vector<Isometry3d>& poses,
+                                   const HierarchyOptions& options = {}) {
+  using Cloud = std::vector<ulc::Vec3<S>>;
+  HierarchyResult<S> out;
+  out.poses = poses;
+  if (frames.size() != poses.size() || options.window < 2 || options.layers < 1) return out;
+
+  std::vector<HierarchyMember<S>> layer(frames.size());
+  for (std::size_t f = 0; f < frames.size(); ++f) {
+    layer[f].begin = f;
+    layer[f].end = f + 1;
+  }
+  for (int l = 0; l < options.layers && layer.size() >= 2; ++l) {
+    const std::size_t w = options.window;
+    const std::size_t n_windows = (layer.size() + w - 1) / w;
+    struct Outcome {
+      WindowBaResult ba;
+      bool ran = false;
+      std::vector<Mat6d> information;
+      HierarchyMember<S> submap;
+    };
+    std::vector<Outcome> outcomes(n_windows);
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, n_windows, 1),
+        [&](const tbb::blocked_range<std::size_t>& r) {
+          for (std::size_t k = r.begin(); k != r.end(); ++k) {
+            const std::size_t first = k * w, last = std::min(first + w, layer.size());
+            std::vector<const Cloud*> clouds;
+            std::vector<Isometry3d> member_poses;
+            for (std::size_t m = first; m < last; ++m) {
+              clouds.push_back(l == 0 ? &frames[layer[m].begin] : &layer[m].cloud);
+              member_poses.push_back(out.poses[layer[m].begin]);
+            }
+            Outcome& o = outcomes[k];
+            if (clouds.size() >= 2) {
+              o.ran = true;
+              o.ba = window_ba(clouds, member_poses, options.ba);
+              const bool usable = o.ba.ok() || o.ba.status == WindowBaStatus::not_converged;
+              if (usable)
+                o.information = hierarchy_detail::marginal_information(o.ba, options.min_sigma);
+              if (!usable || o.information.size() + 1 != clouds.size()) {
+                o.information.clear();
+                o.ba.poses = member_poses;  // unusable: keep the start
+              }
+            } else {
+              o.ba.poses = member_poses;
+            }
+            // The submap: every member's points in the first member's coordinates.
+            const Isometry3d first_inv = o.ba.poses[0].inverse();
+            Cloud merged;
+            for (std::size_t m = 0; m < clouds.size(); ++m) {
+              const Isometry3d T = first_inv * o.ba.poses[m];
+              for (const auto& p : *clouds[m])
+                merged.push_back((T * p.template cast<double>()).template cast<S>());
+            }
+            o.submap.begin = layer[first].begin;
+            o.submap.end = layer[last - 1].end;
+            const auto down = ulc::voxel_downsample(merged, options.submap_voxel);
+            o.submap.cloud = down.ok() ? down.cloud.points : merged;
+          }
+        });
+    // Serial, in window order: move subtrees, collect factors, form the next layer.
+    std::vector<HierarchyMember<S>> next;
+    for (std::size_t k = 0; k < n_windows; ++k) {
+      Outcome& o = outcomes[k];
+      const std::size_t first = k * w, last = std::min(first + w, layer.size());
+      if (o.ran) {
+        ++out.windows;
+        out.planes += o.ba.planes;
+        if (o.information.empty()) ++out.failed_windows;
+      }
+      for (std::size_t m = first; m < last; ++m) {
+        const Isometry3d old_pose = out.poses[layer[m].begin];
+        const Isometry3d delta = o.ba.poses[m - first] * old_pose.inverse();
+        for (std::size_t f = layer[m].begin; f < layer[m].end; ++f)
+          out.poses[f] = delta * out.poses[f];
+        if (m > first && !o.information.empty()) {
+          HierarchyFactor factor;
+          factor.from = layer[first].begin;
+          factor.to = layer[m].begin;
+          factor.measured = o.ba.poses[0].inverse() * o.ba.poses[m - first];
+          factor.information = o.information[m - first - 1];
+          factor.layer = l;
+          out.factors.push_back(factor);
+        }
+      }
+      next.push_back(std::move(o.submap));
+    }
+    out.members.push_back(std::move(layer));
+    layer = std::move(next);
+  }
+  if (!layer.empty()) out.members.push_back(std::move(layer));
+  return out;
+}
+
+}  // namespace hots

@@ -1,0 +1,299 @@
+// HOTS: hierarchical optimisation and time synchronisation, the last stages of the paper
+// (Sec. "Pose Refinement by Hierarchical Optimization" and "Time Synchronization"):
+//   frames + odometry poses of LiDARs a (base) and b (target) + an extrinsic
+//   -> deskewed, downsampled frames -> one hierarchy per LiDAR (hierarchy.hpp)
+//   -> cross-LiDAR links (cross_links.hpp) -> one pose graph with the extrinsic as a variable,
+//      solved by our sparse LM (pose_graph.hpp, sparse_lm.hpp)
+//   -> time synchronisation on the refined poses (time_sync.hpp) -> extrinsic, clock offset.
+//
+// Conventions this header owns:
+//   - Inputs: frames (random-access containers of traits clouds, points in the LiDAR frame at
+//     each point's own time, per-point times relative to the frame timestamp when the cloud has
+//     them), timestamps (own clocks), poses_a = T_mapa_a and poses_b = T_mapb_b at the frame
+//     timestamps, each LiDAR in its own map frame (as jeep's odometry gives them), and the
+//     extrinsic C = T_base_target. Clock offset: t_a = t_b + time_offset_s (DESIGN.md).
+//   - The two maps are put in one world (map a) by T_mapa_mapb = P_a(t_a0) C P_b(t_a0)^-1 at
+//     a's first frame, b's pose interpolated to that instant (identity-free for jeep's
+//     odometry, whose map b is b's frame at a's first instant: T_mapa_mapb = C).
+//   - Frames are deskewed with the motion between their pose and the next frame's (constant
+//     velocity), then voxel-downsampled (frame_voxel).
+//   - Pose graph: one variable per frame of a and b (T_world_frame) and one for C; a's first
+//     frame is the gauge. Factors: every window's BA (information from its Hessian), every
+//     cross link (Huber), and for every b frame an extrinsic tie to the a frame nearest its
+//     instant, with a's motion to that instant taken from the current poses:
+//     r = log((T_a L)^-1 T_b C^-1) (isotropic information, extrinsic_sigma_*). The ties know the
+//     clock offset only through the current estimate, so they are deliberately weak: the
+//     offset itself comes from the time synchronisation, and a second pass (passes = 2)
+//     rebuilds the ties with it.
+//   - Result extrinsic = the time synchronisation's mean (eq:mean); without synchronisation,
+//     the graph's C. covariance_6x6 = the spread of the per-pair extrinsics ([rho; phi], left);
+//     without synchronisation, the graph's marginal covariance of C.
+//   - refined poses are returned in the input map frames (b's through T_mapa_mapb).
+//   - Nothing here throws or prints; results are the same for any number of threads.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <vector>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "hots/cross_links.hpp"
+#include "hots/hierarchy.hpp"
+#include "hots/pose_graph.hpp"
+#include "hots/sparse_lm.hpp"
+#include "hots/time_sync.hpp"
+#include "ulc/core/deskew.hpp"
+#include "ulc/core/point_traits.hpp"
+#include "ulc/core/voxel_downsample.hpp"
+
+namespace hots {
+
+struct RefineOptions {
+  double frame_voxel = 0.1;  ///< m, per-frame downsampling before the BA
+  HierarchyOptions hierarchy;
+  CrossLinkOptions links;
+  SparseLmOptions solver;
+  double extrinsic_sigma_m = 0.05;     ///< per tie
+  double extrinsic_sigma_rad = 0.003;  ///< per tie
+  double link_huber = 3.0;             ///< whitened units
+  double time_offset_s = 0.0;          ///< initial clock offset estimate (centre of the search)
+  bool synchronise_time = true;
+  TimeSyncOptions time_sync;  ///< centre_s is replaced by time_offset_s
+  int passes = 2;
+};
+
+enum class RefineStatus { ok, invalid_input, graph_failed, time_sync_failed };
+
+inline const char* to_string(RefineStatus s) {
+  switch (s) {
+    case RefineStatus::ok:
+      return "ok";
+    case RefineStatus::invalid_input:
+      return "invalid_input";
+    case RefineStatus::graph_failed:
+      return "graph_failed";
+    default:
+      return "time_sync_failed";
+  }
+}
+
+struct RefineStatistics {
+  std::size_t windows = 0, failed_windows = 0, planes = 0;
+  std::size_t ba_factors = 0, cross_links = 0, cross_links_attempted = 0, extrinsic_ties = 0;
+  double graph_initial_cost = 0.0, graph_cost = 0.0;
+  int graph_iterations = 0;
+  double time_sync_spread = 0.0;
+  std::size_t time_sync_pairs = 0;
+  Isometry3d graph_extrinsic = Isometry3d::Identity();  ///< C as the pose graph left it
+};
+
+struct RefineResult {
+  RefineStatus status = RefineStatus::ok;
+  const char* reason = "";
+  Isometry3d extrinsic = Isometry3d::Identity();  ///< T_base_target
+  double time_offset_s = 0.0;
+  Mat6d covariance_6x6 = Mat6d::Zero();
+  std::vector<Isometry3d> poses_a;  ///< T_mapa_a, refined
+  std::vector<Isometry3d> poses_b;  ///< T_mapb_b, refined
+  RefineStatistics statistics;
+  std::vector<std::pair<double, double>> spread_curve;  ///< (offset, spread), last pass
+
+  bool ok() const { return status == RefineStatus::ok; }
+};
+
+namespace hots_detail {
+
+/// Deskewed (constant velocity from the poses) and downsampled copies of the frames.
+template <typename S, class Frames>
+std::vector<std::vector<ulc::Vec3<S>>> prepare_frames(const Frames& frames,
+                                                      const std::vector<double>& times,
+                                                      const std::vector<Isometry3d>& poses,
+                                                      double voxel) {
+  std::vector<std::vector<ulc::Vec3<S>>> out(frames.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, frames.size(), 1),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t k = r.begin(); k != r.end(); ++k) {
+                        const std::size_t j = k + 1 < frames.size() ? k : k - 1;
+                        const double duration = times[j + 1] - times[j];
+                        const Isometry3d motion = poses[j].inverse() * poses[j + 1];
+                        const auto deskewed = ulc::deskew(frames[k], motion, duration);
+                        const auto down = ulc::voxel_downsample(deskewed, voxel);
+                        const auto& pts = down.ok() ? down.cloud.points : deskewed.points;
+                        out[k].reserve(pts.size());
+                        for (const auto& p : pts) out[k].push_back(p.template cast<S>());
+                      }
+                    });
+  return out;
+}
+
+/// The a frame nearest to t (a's clock) and a's motion from it to t (interpolated or
+/// extrapolated with the neighbouring frame).
+inline std::pair<std::size_t, Isometry3d> a_at(const std::vector<double>& times,
+                                               const std::vector<Isometry3d>& poses, double t) {
+  auto it = std::lower_bound(times.begin(), times.end(), t);
+  std::size_t k = static_cast<std::size_t>(it - times.begin());
+  if (k == times.size() || (k > 0 && t - times[k - 1] <= times[k] - t)) --k;
+  const std::size_t j = t >= times[k] ? std::min(k, times.size() - 2) : (k > 0 ? k - 1 : 0);
+  const double span = times[j + 1] - times[j];
+  const double alpha = span > 0.0 ? (t - times[j]) / span : 0.0;
+  const Isometry3d at_t = ulc::interpolate(poses[j], poses[j + 1], alpha);
+  return {k, poses[k].inverse() * at_t};
+}
+
+inline bool usable_times(const std::vector<double>& t) {
+  if (t.size() < 2) return false;
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    if (!std::isfinite(t[i])) return false;
+    if (i > 0 && !(t[i] > t[i - 1])) return false;
+  }
+  return true;
+}
+
+}  // namespace hots_detail
+
+/// See the header comment. S is the scalar of the prepared point clouds (float is plenty).
+template <typename S = float, class FramesA, class FramesB>
+RefineResult refine(const FramesA& frames_a, const std::vector<double>& times_a,
+                    const std::vector<Isometry3d>& poses_a, const FramesB& frames_b,
+                    const std::vector<double>& times_b, const std::vector<Isometry3d>& poses_b,
+                    const Isometry3d& extrinsic, const RefineOptions& options = {}) {
+  namespace d = hots_detail;
+  RefineResult result;
+  result.extrinsic = extrinsic;
+  result.poses_a = poses_a;
+  result.poses_b = poses_b;
+  result.time_offset_s = options.time_offset_s;
+  auto fail = [&](RefineStatus s, const char* why) {
+    result.status = s;
+    result.reason = why;
+    return result;
+  };
+  if (frames_a.size() != times_a.size() || frames_a.size() != poses_a.size() ||
+      frames_b.size() != times_b.size() || frames_b.size() != poses_b.size())
+    return fail(RefineStatus::invalid_input, "frame, time and pose counts differ");
+  if (!d::usable_times(times_a) || !d::usable_times(times_b))
+    return fail(RefineStatus::invalid_input, "need two or more strictly increasing times");
+  if (!extrinsic.matrix().allFinite())
+    return fail(RefineStatus::invalid_input, "extrinsic not finite");
+  for (const auto* list : {&poses_a, &poses_b})
+    for (const Isometry3d& T : *list)
+      if (!T.matrix().allFinite()) return fail(RefineStatus::invalid_input, "a pose is not finite");
+  if (!(options.frame_voxel > 0.0) || options.passes < 1 || !(options.extrinsic_sigma_m > 0.0) ||
+      !(options.extrinsic_sigma_rad > 0.0))
+    return fail(RefineStatus::invalid_input, "bad options");
+
+  // One world: map a.
+  const double t0 = times_a.front() - options.time_offset_s;  // b's clock
+  const Isometry3d b_at_t0 =
+      time_sync_detail::pose_at(times_b, poses_b, std::clamp(t0, times_b.front(), times_b.back()));
+  const Isometry3d mapa_mapb = poses_a.front() * extrinsic * b_at_t0.inverse();
+  std::vector<Isometry3d> world_a = poses_a, world_b;
+  for (const auto& T : poses_b) world_b.push_back(mapa_mapb * T);
+
+  const auto fa = d::prepare_frames<S>(frames_a, times_a, poses_a, options.frame_voxel);
+  const auto fb = d::prepare_frames<S>(frames_b, times_b, poses_b, options.frame_voxel);
+
+  const auto ha = build_hierarchy(fa, world_a, options.hierarchy);
+  const auto hb = build_hierarchy(fb, world_b, options.hierarchy);
+  RefineStatistics& st = result.statistics;
+  st.windows = ha.windows + hb.windows;
+  st.failed_windows = ha.failed_windows + hb.failed_windows;
+  st.planes = ha.planes + hb.planes;
+  world_a = ha.poses;
+  world_b = hb.poses;
+
+  CrossLinkStats link_stats;
+  const auto links = cross_links(ha, fa, times_a, world_a, hb, fb, times_b, world_b,
+                                 options.time_offset_s, options.links, &link_stats);
+  st.cross_links = links.size();
+  st.cross_links_attempted = link_stats.attempted;
+
+  const std::size_t na = frames_a.size(), nb = frames_b.size();
+  PoseGraph graph;
+  for (std::size_t i = 0; i < na; ++i) graph.add_variable(world_a[i], i == 0);
+  for (std::size_t j = 0; j < nb; ++j) graph.add_variable(world_b[j]);
+  const std::size_t c_var = graph.add_variable(extrinsic);
+  auto add_relative = [&](std::size_t from, std::size_t to, const Isometry3d& Z, const Mat6d& info,
+                          double huber, int kind) {
+    PoseFactor f;
+    f.from = from;
+    f.to = to;
+    f.measured = Z;
+    f.sqrt_information = sqrt_information(info);
+    f.huber = huber;
+    f.kind = kind;
+    graph.add_factor(f);
+  };
+  for (const auto& f : ha.factors) add_relative(f.from, f.to, f.measured, f.information, 0.0, 0);
+  for (const auto& f : hb.factors)
+    add_relative(na + f.from, na + f.to, f.measured, f.information, 0.0, 0);
+  st.ba_factors = ha.factors.size() + hb.factors.size();
+  for (const auto& l : links)
+    add_relative(l.frame_a, na + l.frame_b, l.measured, l.information, options.link_huber, 1);
+  const std::size_t first_tie = graph.factors.size();
+  const Mat6d tie_sqrt =
+      isotropic_sqrt_information(options.extrinsic_sigma_m, options.extrinsic_sigma_rad);
+  auto set_ties = [&](double offset) {
+    graph.factors.resize(first_tie);
+    std::vector<double> ta = times_a;
+    std::vector<Isometry3d> pa(graph.variables.begin(),
+                               graph.variables.begin() + static_cast<std::ptrdiff_t>(na));
+    for (std::size_t j = 0; j < nb; ++j) {
+      const double t = times_b[j] + offset;  // a's clock
+      if (t < times_a.front() || t > times_a.back()) continue;
+      const auto [i, L] = d::a_at(ta, pa, t);
+      PoseFactor f;
+      f.from = i;
+      f.from_offset = L;
+      f.to = na + j;
+      f.measured_var = c_var;
+      f.sqrt_information = tie_sqrt;
+      f.kind = 2;
+      graph.add_factor(f);
+    }
+    st.extrinsic_ties = graph.factors.size() - first_tie;
+  };
+
+  double offset = options.time_offset_s;
+  for (int pass = 0; pass < options.passes; ++pass) {
+    set_ties(offset);
+    const SparseLmResult lm = solve_pose_graph(graph, options.solver);
+    if (pass == 0) st.graph_initial_cost = lm.initial_cost;
+    st.graph_cost = lm.cost;
+    st.graph_iterations += lm.iterations;
+    if (!(lm.ok() || lm.status == SparseLmStatus::not_converged))
+      return fail(RefineStatus::graph_failed, lm.reason);
+    st.graph_extrinsic = graph.variables[c_var];
+    result.extrinsic = graph.variables[c_var];
+    if (!options.synchronise_time) {
+      result.covariance_6x6 = marginal_covariance(graph, c_var, options.solver.grain);
+      break;
+    }
+    std::vector<Isometry3d> wa(graph.variables.begin(),
+                               graph.variables.begin() + static_cast<std::ptrdiff_t>(na));
+    std::vector<Isometry3d> wb(graph.variables.begin() + static_cast<std::ptrdiff_t>(na),
+                               graph.variables.begin() + static_cast<std::ptrdiff_t>(na + nb));
+    TimeSyncOptions ts = options.time_sync;
+    ts.centre_s = options.time_offset_s;
+    const TimeSyncResult sync = time_sync(times_a, wa, times_b, wb, ts);
+    if (!sync.ok()) return fail(RefineStatus::time_sync_failed, sync.reason);
+    offset = sync.time_offset_s;
+    result.time_offset_s = offset;
+    result.extrinsic = sync.extrinsic;
+    result.covariance_6x6 = sync.covariance;
+    result.spread_curve = sync.curve;
+    st.time_sync_spread = sync.spread;
+    st.time_sync_pairs = sync.pairs;
+    graph.variables[c_var] = sync.extrinsic;
+  }
+
+  const Isometry3d mapb_mapa = mapa_mapb.inverse();
+  for (std::size_t i = 0; i < na; ++i) result.poses_a[i] = graph.variables[i];
+  for (std::size_t j = 0; j < nb; ++j) result.poses_b[j] = mapb_mapa * graph.variables[na + j];
+  return result;
+}
+
+}  // namespace hots

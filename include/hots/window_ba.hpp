@@ -1,0 +1,264 @@
+// Window bundle adjustment: the poses of a few frames refined so that the planes they see
+// (plane_extraction.hpp) are as thin as possible (the paper's local LiDAR BA inside a window,
+// Sec. "Pose Refinement by Hierarchical Optimization", after BALM).
+//
+// Conventions this header owns:
+//   - Input poses T_world_frame of the window's frames. The BA works in the window frame, the
+//     first frame's: T_window_i = T_world_0^-1 T_world_i. The first pose is the gauge and never
+//     moves; the result's poses are T_world_0 * T_window_i (the first one is returned as given).
+//   - Cost = sum over planes of lambda_min of the plane's scatter (point_cluster.hpp): the sum of
+//     squared point-to-plane distances, m^2. Planes are extracted at the initial poses, and again
+//     at the refined poses for each further round (options.rounds).
+//   - Levenberg-Marquardt on the exact Hessian of that cost with left perturbations
+//     T_window_i <- exp(xi_i) T_window_i, xi = [rho; phi]; damping H + mu I with Nielsen's rule
+//     (mu *= max(1/3, 1 - (2 rho - 1)^3) on success, mu *= nu, nu *= 2 on failure).
+//   - `hessian` (6W x 6W, frame 0's block included) and `gradient` are at the returned poses,
+//     for perturbations in the window frame: the information of the relative poses
+//     T_window_i is hessian / (2 noise_variance) (cost = sum of squared residuals), with
+//     noise_variance = cost / (points - 3 planes).
+//   - Sums over planes use deterministic_reduce with a fixed grain: the same bits for any
+//     number of threads. Nothing here throws or prints.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <vector>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+
+#include "hots/plane_extraction.hpp"
+#include "hots/point_cluster.hpp"
+#include "ulc/core/lie.hpp"
+#include "ulc/core/parallel_reduce.hpp"
+
+namespace hots {
+
+struct WindowBaOptions {
+  PlaneExtractionOptions planes;
+  /// Plane extractions: after the first converges, planes are extracted again at the refined
+  /// poses (cells that mixed two surfaces at a poor start separate) and LM runs again.
+  int rounds = 2;
+  int max_iterations = 30;        ///< LM steps per round
+  double initial_damping = 1e-4;  ///< mu_0 = this * max diagonal of the Hessian
+  double step_tolerance = 1e-8;   ///< stop when every step entry (m, rad) is below this
+  double cost_tolerance = 1e-10;  ///< stop when an accepted step lowers the cost by less (rel.)
+  std::size_t min_planes = 10;
+  PlaneEvaluationOptions evaluation;
+  std::size_t grain = 32;  ///< planes per parallel chunk (fixed: results never depend on it)
+};
+
+enum class WindowBaStatus { ok, not_converged, too_few_planes, invalid_input };
+
+inline const char* to_string(WindowBaStatus s) {
+  switch (s) {
+    case WindowBaStatus::ok:
+      return "ok";
+    case WindowBaStatus::not_converged:
+      return "not_converged";
+    case WindowBaStatus::too_few_planes:
+      return "too_few_planes";
+    default:
+      return "invalid_input";
+  }
+}
+
+struct WindowBaResult {
+  WindowBaStatus status = WindowBaStatus::ok;
+  const char* reason = "";
+  std::vector<Isometry3d> poses;  ///< T_world_i, refined
+  Eigen::MatrixXd hessian;        ///< 6W x 6W, window frame (see the header comment)
+  Eigen::VectorXd gradient;
+  double initial_cost = 0.0;
+  double cost = 0.0;
+  double noise_variance = 0.0;  ///< m^2 per point
+  std::size_t planes = 0;
+  std::size_t points = 0;
+  std::size_t degenerate_planes = 0;  ///< at the returned poses
+  int iterations = 0;                 ///< LM steps tried
+
+  bool ok() const { return status == WindowBaStatus::ok; }
+};
+
+namespace window_ba_detail {
+
+struct Sums {
+  Eigen::MatrixXd H;
+  Eigen::VectorXd g;
+  double cost = 0.0;
+  std::size_t degenerate = 0;
+};
+
+inline Sums evaluate(const std::vector<Plane>& planes, const std::vector<Isometry3d>& poses,
+                     const WindowBaOptions& o) {
+  const auto n = static_cast<Eigen::Index>(6 * poses.size());
+  Sums identity;
+  identity.H = Eigen::MatrixXd::Zero(n, n);
+  identity.g = Eigen::VectorXd::Zero(n);
+  const auto body = [&](std::size_t begin, std::size_t end, Sums acc) {
+    for (std::size_t p = begin; p < end; ++p) {
+      const Plane& plane = planes[p];
+      const PlaneDerivatives d = evaluate_plane(plane.frames, poses, plane.anchor, o.evaluation);
+      acc.cost += d.cost;
+      if (d.degenerate) {
+        ++acc.degenerate;
+        continue;
+      }
+      for (std::size_t a = 0; a < plane.frames.size(); ++a) {
+        const auto ia = static_cast<Eigen::Index>(6 * plane.frames[a].frame);
+        const auto la = static_cast<Eigen::Index>(6 * a);
+        acc.g.segment<6>(ia) += d.gradient.segment<6>(la);
+        for (std::size_t b = 0; b < plane.frames.size(); ++b) {
+          const auto ib = static_cast<Eigen::Index>(6 * plane.frames[b].frame);
+          acc.H.block<6, 6>(ia, ib) += d.hessian.block<6, 6>(la, static_cast<Eigen::Index>(6 * b));
+        }
+      }
+    }
+    return acc;
+  };
+  const auto join = [](Sums a, const Sums& b) {
+    a.H += b.H;
+    a.g += b.g;
+    a.cost += b.cost;
+    a.degenerate += b.degenerate;
+    return a;
+  };
+  return ulc::deterministic_reduce(planes.size(), identity, body, join, o.grain);
+}
+
+inline double cost(const std::vector<Plane>& planes, const std::vector<Isometry3d>& poses,
+                   const WindowBaOptions& o) {
+  return ulc::deterministic_reduce(
+      planes.size(), 0.0,
+      [&](std::size_t begin, std::size_t end, double acc) {
+        for (std::size_t p = begin; p < end; ++p)
+          acc += plane_cost(planes[p].frames, poses, planes[p].anchor);
+        return acc;
+      },
+      [](double a, double b) { return a + b; }, o.grain);
+}
+
+inline bool valid_options(const WindowBaOptions& o) {
+  return valid_plane_extraction_options(o.planes) && o.rounds >= 1 && o.max_iterations >= 0 &&
+         o.initial_damping > 0.0 && o.step_tolerance >= 0.0 && o.cost_tolerance >= 0.0 &&
+         o.grain >= 1;
+}
+
+}  // namespace window_ba_detail
+
+/// Refines the poses of frames[1..] with frames[0] fixed (see the header comment).
+template <class Cloud>
+WindowBaResult window_ba(const std::vector<const Cloud*>& frames,
+                         const std::vector<Isometry3d>& poses_world,
+                         const WindowBaOptions& options = {}) {
+  namespace d = window_ba_detail;
+  WindowBaResult result;
+  result.poses = poses_world;
+  const std::size_t W = frames.size();
+  if (W < 2 || poses_world.size() != W || !d::valid_options(options)) {
+    result.status = WindowBaStatus::invalid_input;
+    result.reason = W < 2 ? "a window needs at least two frames"
+                          : "frame and pose counts differ, or bad options";
+    return result;
+  }
+  for (const Isometry3d& T : poses_world) {
+    if (!T.matrix().allFinite()) {
+      result.status = WindowBaStatus::invalid_input;
+      result.reason = "a pose is not finite";
+      return result;
+    }
+  }
+  const Isometry3d origin = poses_world[0];
+  const Isometry3d origin_inv = origin.inverse();
+  std::vector<Isometry3d> x(W);
+  for (std::size_t i = 0; i < W; ++i) x[i] = origin_inv * poses_world[i];
+  x[0] = Isometry3d::Identity();
+
+  const auto n = static_cast<Eigen::Index>(6 * W);
+  const Eigen::Index m = n - 6;  // the gauge's block is left out
+  std::vector<Plane> planes;
+  d::Sums sums;
+  bool converged = false;
+  for (int round = 0; round < options.rounds; ++round) {
+    planes = extract_planes(frames, x, options.planes);
+    result.planes = planes.size();
+    result.points = 0;
+    for (const Plane& p : planes) result.points += p.points;
+    if (planes.size() < options.min_planes) {
+      result.status = WindowBaStatus::too_few_planes;
+      result.reason = "fewer planar cells than min_planes";
+      result.hessian = Eigen::MatrixXd::Zero(n, n);
+      result.gradient = Eigen::VectorXd::Zero(n);
+      for (std::size_t i = 1; i < W; ++i) result.poses[i] = origin * x[i];
+      return result;
+    }
+    sums = d::evaluate(planes, x, options);
+    if (round == 0) result.initial_cost = sums.cost;
+    double mu = options.initial_damping * std::max(sums.H.diagonal().tail(m).maxCoeff(), 1e-12);
+    double nu = 2.0;
+    converged = false;
+    for (int it = 0; it < options.max_iterations && !converged; ++it) {
+      ++result.iterations;
+      const Eigen::MatrixXd H = sums.H.bottomRightCorner(m, m);
+      const Eigen::VectorXd g = sums.g.tail(m);
+      const Eigen::LLT<Eigen::MatrixXd> llt(H + mu * Eigen::MatrixXd::Identity(m, m));
+      if (llt.info() != Eigen::Success) {  // H indefinite here: damp harder
+        mu *= nu;
+        nu *= 2.0;
+        continue;
+      }
+      const Eigen::VectorXd step = llt.solve(-g);
+      if (!step.allFinite()) break;
+      if (step.cwiseAbs().maxCoeff() < options.step_tolerance) {
+        converged = true;
+        break;
+      }
+      std::vector<Isometry3d> trial = x;
+      for (std::size_t i = 1; i < W; ++i)
+        trial[i] =
+            ulc::se3_exp(Vec6d(step.segment<6>(static_cast<Eigen::Index>(6 * (i - 1))))) * x[i];
+      const double trial_cost = d::cost(planes, trial, options);
+      const double predicted = -(g.dot(step) + 0.5 * step.dot(H * step));
+      const double actual = sums.cost - trial_cost;
+      const double rho = predicted > 0.0 ? actual / predicted : -1.0;
+      if (rho > 0.0) {
+        x = trial;
+        const double before = sums.cost;
+        sums = d::evaluate(planes, x, options);
+        mu *= std::max(1.0 / 3.0, 1.0 - std::pow(2.0 * rho - 1.0, 3));
+        nu = 2.0;
+        if (actual < options.cost_tolerance * before) converged = true;
+      } else {
+        mu *= nu;
+        nu *= 2.0;
+      }
+    }
+  }
+
+  result.cost = sums.cost;
+  result.hessian = sums.H;
+  result.gradient = sums.g;
+  result.degenerate_planes = sums.degenerate;
+  const double dof = static_cast<double>(result.points) - 3.0 * static_cast<double>(result.planes);
+  result.noise_variance = dof > 0.0 ? result.cost / dof : 0.0;
+  for (std::size_t i = 1; i < W; ++i) result.poses[i] = origin * x[i];
+  if (!converged && options.max_iterations > 0) {
+    result.status = WindowBaStatus::not_converged;
+    result.reason = "max_iterations reached before the step or the cost change was small";
+  }
+  return result;
+}
+
+/// window_ba over every frame of a container of clouds.
+template <class Cloud>
+WindowBaResult window_ba(const std::vector<Cloud>& frames,
+                         const std::vector<Isometry3d>& poses_world,
+                         const WindowBaOptions& options = {}) {
+  std::vector<const Cloud*> views;
+  views.reserve(frames.size());
+  for (const Cloud& c : frames) views.push_back(&c);
+  return window_ba(views, poses_world, options);
+}
+
+}  // namespace hots
