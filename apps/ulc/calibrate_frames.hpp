@@ -1,6 +1,7 @@
 // Loading only the frames `ulc calibrate` needs: TERRA reads frame i of each LiDAR; JEEP pairs
 // frames by timestamp from frame i on and uses the first K pairs, so it needs K frames of the
-// base and the target frames spanning the same time (more of them when the target runs faster).
+// base and the target frames spanning the same time (more of them when the target runs faster);
+// HOTS uses every frame from i on.
 // Frames are read as ulc::PointCloud<float> with per-point times relative to the frame.
 #pragma once
 

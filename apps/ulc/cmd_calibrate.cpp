@@ -1,5 +1,5 @@
 // `ulc calibrate`: the extrinsic of every target LiDAR against the base, through the stages asked
-// for (terra, jeep), written as the result file of DESIGN.md and summarised on stdout.
+// for (terra, jeep, hots), written as the result file of DESIGN.md and summarised on stdout.
 #include <tbb/task_arena.h>
 
 #include <cstdio>
@@ -44,12 +44,12 @@ class StageProgress {
 };
 
 std::vector<Stage> stages_option(const cli::Args& args) {
-  const ParsedStages parsed = parse_stages(args.get("stages", "terra,jeep"));
+  const ParsedStages parsed = parse_stages(args.get("stages", "terra,jeep,hots"));
   if (!parsed.ok()) throw cli::UsageError("calibrate: option '--stages': " + parsed.error);
   for (const Stage s : parsed.stages)
     if (!stage_available(s))
       throw cli::UsageError(std::string("calibrate: option '--stages': stage '") + to_string(s) +
-                            "' is not available yet (this build runs terra and jeep)");
+                            "' is not available in this build");
   return parsed.stages;
 }
 
@@ -68,8 +68,12 @@ void print_summary(const io::PairResult& r) {
   const Eigen::Vector3d rpy = ulc::rpy_from_rotation(r.T_base_target.linear()) * kDeg;
   std::printf("  xyz_m   %9.4f %9.4f %9.4f\n", t.x(), t.y(), t.z());
   std::printf("  rpy_deg %9.3f %9.3f %9.3f\n", rpy.x(), rpy.y(), rpy.z());
-  std::printf("  time_s  terra %.2f  jeep %.2f  total %.2f\n", r.timing_s.at("terra").as_number(),
-              r.timing_s.at("jeep").as_number(), r.timing_s.at("total").as_number());
+  if (r.stages.find("hots"))
+    std::printf("  time_offset_ms %.2f\n", r.time_offset_s ? *r.time_offset_s * 1e3 : 0.0);
+  std::printf("  time_s  terra %.2f  jeep %.2f  odometry %.2f  hots %.2f  total %.2f\n",
+              r.timing_s.at("terra").as_number(), r.timing_s.at("jeep").as_number(),
+              r.timing_s.at("odometry").as_number(), r.timing_s.at("hots").as_number(),
+              r.timing_s.at("total").as_number());
 }
 
 }  // namespace
@@ -79,22 +83,24 @@ int run_calibrate(int argc, char** argv) {
   args.option("base", "PATH", "the base LiDAR: a frame folder or one frame file", true)
       .option("target", "PATH", "a target LiDAR: a frame folder or one frame file", true, true)
       .option("output", "FILE", "write the result file (DESIGN.md) here")
-      .option("stages", "LIST", "terra, jeep or terra,jeep (default terra,jeep)")
+      .option("stages", "LIST", "an ordered subset of terra,jeep,hots (default terra,jeep,hots)")
       .option("initial", "GUESS",
-              "\"x y z roll pitch yaw\" (m, deg; R = Rz Ry Rx) or a result file; needed by "
-              "--stages jeep")
-      .option("frame-index", "N", "TERRA's frame and JEEP's first frame (default 0)")
+              "\"x y z roll pitch yaw\" (m, deg; R = Rz Ry Rx) or a result file; needed when "
+              "the stages skip terra")
+      .option("frame-index", "N", "TERRA's frame, and the first frame of JEEP and HOTS (default 0)")
       .option("frames", "K", "frame pairs JEEP uses (default 5)")
       .option("threads", "N", "worker threads (default: all cores)")
       .flag("quiet", "no progress on stderr")
       .flag("help", "show this help");
   args.parse(argc, argv, 1);
   if (args.has("help")) {
-    std::printf("%s", args.help_text("Finds the extrinsic T_base_target of each target LiDAR "
-                                     "against the base, with no initial guess (TERRA) and "
-                                     "refined (JEEP). Exit 0: all calibrated; 1: some did not "
-                                     "(the result file says why); 2: bad usage or input.")
-                          .c_str());
+    std::printf("%s",
+                args.help_text("Finds the extrinsic T_base_target of each target LiDAR "
+                               "against the base, with no initial guess (TERRA), "
+                               "refined (JEEP), then over every frame with the clock "
+                               "offset (odometry + HOTS). Exit 0: all calibrated; 1: some did not "
+                               "(the result file says why); 2: bad usage or input.")
+                    .c_str());
     return kExitOk;
   }
 
@@ -102,10 +108,11 @@ int run_calibrate(int argc, char** argv) {
   options.stages = stages_option(args);
   const bool run_terra = has_stage(options.stages, Stage::terra);
   const bool run_jeep = has_stage(options.stages, Stage::jeep);
+  const bool run_hots = has_stage(options.stages, Stage::hots);
   if (run_terra && args.has("initial"))
     throw cli::UsageError(
         "calibrate: option '--initial' is only used when the stages skip terra (TERRA needs no "
-        "guess); use --stages jeep with it");
+        "guess); use --stages jeep,hots or hots with it");
   if (!run_terra && !args.has("initial"))
     throw cli::UsageError("calibrate: --stages " + stages_to_string(options.stages) +
                           " needs an initial extrinsic: --initial \"x y z roll pitch yaw\" or "
@@ -126,13 +133,18 @@ int run_calibrate(int argc, char** argv) {
   for (const auto& t : targets) require_frame(t, frame_index);
 
   // The frames each stage needs, counted from frame_index; the base's are shared by all targets.
-  const std::size_t base_count = run_jeep ? options.jeep.frames : 1;
+  // HOTS needs them all.
+  const std::size_t base_count = run_hots   ? base.size() - frame_index
+                                 : run_jeep ? options.jeep.frames
+                                            : 1;
   const bool quiet = args.has("quiet");
   const LoadedFrames base_frames = load_frames(base, frame_index, base_count);
 
   std::vector<io::PairResult> results;
   for (const auto& target : targets) {
-    const std::size_t count = run_jeep ? covering_count(base, target, base_count) : 1;
+    const std::size_t count = run_hots   ? target.size() - frame_index
+                              : run_jeep ? covering_count(base, target, base_count)
+                                         : 1;
     const LoadedFrames target_frames = load_frames(target, frame_index, count);
     CalibrateOptions pair_options = options;
     pair_options.frame_index = 0;  // the loaded frames start at frame_index

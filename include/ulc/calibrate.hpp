@@ -3,8 +3,8 @@
 //
 //   frames of a, b -> TERRA(a[i], b[i])              -> R0 (translation zero)
 //                  -> JEEP(pairs from frame i on, R0) -> C1
-// (odometry over all frames, HOTS and time sync come later: a new Stage and a new block in
-// calibrate_pair, each taking the previous stage's extrinsic.)
+//                  -> odometry(all frames from i on, C1) -> poses
+//                  -> HOTS(all frames from i on, poses, C1) -> C2, clock offset, covariance
 //
 // Conventions this header owns (result conventions: calibrate/pair_calibration.hpp):
 //   - Inputs: the frames of each LiDAR (any random-access container of clouds with point traits,
@@ -13,11 +13,19 @@
 //   - frame_index i: TERRA uses frame i of each LiDAR (the same index, so clock offsets do not
 //     matter); JEEP pairs frames by timestamp from frame i of each on and uses the first
 //     JeepOptions::frames pairs. Frames before i are never touched.
-//   - Stages: any of "terra", "jeep", "terra,jeep" (stages.hpp). TERRA needs no prior and
-//     ignores `initial`; JEEP starts from TERRA's rotation when terra ran, else from `initial`,
-//     which is then required (status initial_required without it).
-//   - Progress: options.progress(stage, fraction in [0, 1]) on the calling thread.
-//   - Threads: TERRA and JEEP are deterministic for any thread count, so is this. Run inside a
+//   - Stages: any ordered subset of terra, jeep, hots (stages.hpp); the default is all three
+//     (DESIGN.md). TERRA needs no prior and ignores `initial`; each later stage starts from the
+//     previous stage's extrinsic, or from `initial` when it is the first, which is then
+//     required (status initial_required without it).
+//   - HOTS: multi-LiDAR odometry (options.odometry) over ALL frames of each LiDAR from frame i
+//     on, with the extrinsic HOTS starts from, then hots::refine (options.hots) on those frames
+//     and poses. Its extrinsic, clock offset and covariance become the result's. An odometry
+//     that could not register some frames still feeds HOTS (its poses are predictions there;
+//     the report counts them); an odometry that gives no poses, or a HOTS that fails, ends the
+//     call with hots_failed, keeping the previous extrinsic.
+//   - Progress: options.progress(stage, fraction in [0, 1]) on the calling thread; stages
+//     "terra", "jeep", "odometry", "hots" (HOTS reports only 0 and 1).
+//   - Threads: every stage is deterministic for any thread count, so is this. Run inside a
 //     tbb::task_arena to limit threads.
 //   - Nothing here throws, exits or prints; it compiles with -fno-exceptions.
 #pragma once
@@ -29,7 +37,9 @@
 #include <string>
 #include <vector>
 
+#include "hots/hots.hpp"
 #include "jeep/jeep.hpp"
+#include "jeep/run_odometry.hpp"
 #include "terra/search.hpp"
 #include "ulc/calibrate/frame_range.hpp"
 #include "ulc/calibrate/pair_calibration.hpp"
@@ -39,15 +49,18 @@
 
 namespace ulc {
 
-/// Called with the running stage's name ("terra", "jeep") and its fraction done.
+/// Called with the running stage's name ("terra", "jeep", "odometry", "hots") and its fraction
+/// done.
 using CalibrateProgress = std::function<void(const std::string& stage, double fraction)>;
 
 /// Everything calibrate_pair can be told; the defaults are the paper's.
 struct CalibrateOptions {
-  terra::SearchParams terra;  ///< N = 10000, d1 = 20 m, d2 = 5 m, alpha = 2, 10/1 deg strides
-  jeep::JeepOptions jeep;     ///< K = 5 frame pairs, at most 10 rounds
-  std::vector<Stage> stages{Stage::terra, Stage::jeep};
-  std::size_t frame_index = 0;        ///< TERRA's frame, and JEEP's first
+  terra::SearchParams terra;       ///< N = 10000, d1 = 20 m, d2 = 5 m, alpha = 2, 10/1 deg strides
+  jeep::JeepOptions jeep;          ///< K = 5 frame pairs, at most 10 rounds
+  jeep::OdometryOptions odometry;  ///< the odometry over all frames that feeds HOTS
+  hots::RefineOptions hots;        ///< windows of 5, 3 layers, time synchronisation on
+  std::vector<Stage> stages{Stage::terra, Stage::jeep, Stage::hots};
+  std::size_t frame_index = 0;        ///< TERRA's frame, and the first frame of the others
   std::optional<Isometry3d> initial;  ///< T_base_target guess, used when terra does not run
   CalibrateProgress progress;         ///< optional
 };
@@ -96,6 +109,37 @@ inline JeepReport jeep_report(const jeep::JeepResult& j, const Isometry3d& initi
   return r;
 }
 
+inline HotsReport hots_report(const jeep::OdometryResult& odo, const Isometry3d& initial,
+                              double odometry_seconds) {
+  HotsReport h;
+  h.status = "not_run";
+  h.odometry_status = jeep::to_string(odo.status);
+  h.odometry_reason = odo.reason;
+  h.frames_base = odo.poses_a.size();
+  h.frames_target = odo.poses_b.size();
+  h.odometry_failed_steps = odo.failed_steps;
+  h.initial = initial;
+  h.extrinsic = initial;
+  h.odometry_seconds = odometry_seconds;
+  return h;
+}
+
+inline void add_refine(HotsReport& h, const hots::RefineResult& r, double seconds) {
+  h.status = hots::to_string(r.status);
+  h.reason = r.reason;
+  h.extrinsic = r.extrinsic;
+  h.time_offset_s = r.time_offset_s;
+  h.covariance_6x6 = r.covariance_6x6;
+  h.statistics = r.statistics;
+  h.spread_curve = r.spread_curve;
+  h.seconds = seconds;
+}
+
+/// Odometry gave a pose to every frame (possibly predicted ones): HOTS can start.
+inline bool odometry_usable(const jeep::OdometryResult& odo) {
+  return odo.ok() || odo.status == jeep::OdometryStatus::registration_failed;
+}
+
 }  // namespace calibrate_detail
 
 /// Calibrates target LiDAR b against base LiDAR a (see the conventions at the top).
@@ -134,6 +178,7 @@ PairCalibration calibrate_pair(const FramesA& frames_a, const std::vector<double
                       std::to_string(frames_b.size()) + ")");
   const bool run_terra = has_stage(options.stages, Stage::terra);
   const bool run_jeep = has_stage(options.stages, Stage::jeep);
+  const bool run_hots = has_stage(options.stages, Stage::hots);
   if (!run_terra && !options.initial)
     return finish(CalibrateStatus::initial_required,
                   "stages without terra need an initial extrinsic (TERRA is what finds one "
@@ -182,6 +227,42 @@ PairCalibration calibrate_pair(const FramesA& frames_a, const std::vector<double
     report("jeep", 1.0);
     C = j.extrinsic;
     r.T_base_target = C;
+  }
+
+  if (run_hots) {
+    const FrameRange<FramesA> view_a(frames_a, i);
+    const FrameRange<FramesB> view_b(frames_b, i);
+    const std::vector<double> ta = times_from(times_a, i), tb = times_from(times_b, i);
+    auto t0 = std::chrono::steady_clock::now();
+    jeep::ProgressFn progress;
+    if (options.progress)
+      progress = [&](std::size_t done, std::size_t total) {
+        report("odometry", total ? static_cast<double>(done) / static_cast<double>(total) : 1.0);
+      };
+    report("odometry", 0.0);
+    const jeep::OdometryResult odo =
+        jeep::run_odometry(view_a, ta, view_b, tb, C, options.odometry, progress);
+    r.timing_s.odometry = seconds_since(t0);
+    r.hots = calibrate_detail::hots_report(odo, C, r.timing_s.odometry);
+    if (!calibrate_detail::odometry_usable(odo))
+      return finish(
+          CalibrateStatus::hots_failed,
+          std::string("HOTS: odometry: ") + jeep::to_string(odo.status) + ": " + odo.reason);
+    report("odometry", 1.0);
+    report("hots", 0.0);
+    t0 = std::chrono::steady_clock::now();
+    const hots::RefineResult h =
+        hots::refine(view_a, ta, odo.poses_a, view_b, tb, odo.poses_b, C, options.hots);
+    r.timing_s.hots = seconds_since(t0);
+    calibrate_detail::add_refine(*r.hots, h, r.timing_s.hots);
+    if (!h.ok())
+      return finish(CalibrateStatus::hots_failed,
+                    std::string("HOTS: ") + hots::to_string(h.status) + ": " + h.reason);
+    report("hots", 1.0);
+    C = h.extrinsic;
+    r.T_base_target = C;
+    r.time_offset_s = h.time_offset_s;
+    r.covariance_6x6 = h.covariance_6x6;
   }
   return finish(CalibrateStatus::ok, "");
 }

@@ -28,6 +28,19 @@ inline const ulc::sim::Dataset& drive_64_32() {
   return d;
 }
 
+/// Three seconds (30 frames of each LiDAR) of the same drive, decimated 4x: enough windows for
+/// HOTS's hierarchy while the test stays short.
+inline const ulc::sim::Dataset& drive_64_32_hots() {
+  static const ulc::sim::Dataset d = [] {
+    ulc::sim::SimulationOptions o;
+    o.seconds = 3.0;
+    o.seed = 3;
+    o.decimation = 4;
+    return ulc::sim::simulate(*ulc::sim::scenario("64-32"), o).dataset;
+  }();
+  return d;
+}
+
 /// The same frames as std::vector<Eigen::Vector3d> (double, no per-point times).
 inline std::vector<std::vector<Eigen::Vector3d>> as_vectors(
     const std::vector<ulc::PointCloud<float>>& frames) {

@@ -37,6 +37,7 @@ TEST_CASE("terra,jeep recovers the 64-32 mounting with no initial guess", "[cali
   };
   std::vector<Call> calls;
   ulc::CalibrateOptions o;
+  o.stages = {Stage::terra, Stage::jeep};  // six frames are too few for HOTS: see test_hots_stage
   o.progress = [&](const std::string& stage, double f) { calls.push_back({stage, f}); };
   const auto r = ulc::calibrate_pair(base().frames, base().timestamps, target().frames,
                                      target().timestamps, o);
@@ -145,15 +146,13 @@ TEST_CASE("refusals come back as a status and a reason", "[calibrate][status]") 
   expect(ulc::calibrate_pair(fa, ta, fb, tb, o), CalibrateStatus::invalid_input, "not finite");
 
   o = {};
-  o.stages = {Stage::terra, Stage::jeep, Stage::hots};
-  expect(ulc::calibrate_pair(fa, ta, fb, tb, o), CalibrateStatus::stage_not_available,
-         "'hots' is not available yet");
   o.stages = {Stage::jeep, Stage::terra};
   expect(ulc::calibrate_pair(fa, ta, fb, tb, o), CalibrateStatus::invalid_input, "order");
   o.stages = {};
   expect(ulc::calibrate_pair(fa, ta, fb, tb, o), CalibrateStatus::invalid_input, "no stage");
 
   o = {};
+  o.stages = {Stage::terra, Stage::jeep};
   o.frame_index = fa.size();
   expect(ulc::calibrate_pair(fa, ta, fb, tb, o), CalibrateStatus::invalid_input, "past the end");
   o.frame_index = 0;
@@ -188,6 +187,7 @@ TEST_CASE("refusals come back as a status and a reason", "[calibrate][status]") 
 
 TEST_CASE("calibrate_pair gives the same bits on 1 and 2 threads", "[calibrate][threads]") {
   ulc::CalibrateOptions o;
+  o.stages = {Stage::terra, Stage::jeep};
   o.jeep.frames = 3;
   o.frame_index = 1;
   auto run = [&] {
@@ -230,7 +230,8 @@ TEST_CASE("the result-file entry has the fields of DESIGN.md", "[calibrate][resu
   CHECK(back[0].success);
   CHECK(back[0].status == "ok");
   CHECK(back[0].T_base_target.isApprox(c.T_base_target, 1e-15));
-  CHECK(*back[0].time_offset_s == 0.0);
+  CHECK(*back[0].time_offset_s == 0.0);  // no HOTS: clocks assumed synchronised
+  CHECK(!back[0].covariance_6x6);
   for (const char* key : {"terra", "jeep", "odometry", "hots", "total"})
     CHECK(back[0].timing_s.at(key).is_number());
   CHECK(back[0].timing_s.at("terra").as_number() == c.timing_s.terra);

@@ -6,15 +6,20 @@
 //     failed (TERRA's rotation or the initial guess; identity when TERRA failed), kept for
 //     inspection only: `success` false means "do not use it".
 //   - `status` is one word for programs (CalibrateStatus); `reason` is one human sentence that
-//     names the stage and its own status. Each stage that ran leaves its report (terra, jeep).
+//     names the stage and its own status. Each stage that ran leaves its report (terra, jeep,
+//     hots).
+//   - When HOTS fails, T_base_target keeps JEEP's extrinsic (or the initial guess) and success is
+//     false; hots->extrinsic still holds what HOTS reached, for inspection.
 //   - Times are wall-clock seconds (std::chrono::steady_clock): statistics, never decisions.
 #pragma once
 
 #include <cstddef>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "hots/hots.hpp"
 #include "terra/search_params.hpp"
 #include "ulc/calibrate/stages.hpp"
 #include "ulc/core/types.hpp"
@@ -25,9 +30,10 @@ enum class CalibrateStatus {
   ok,
   invalid_input,        ///< bad options, empty inputs, frame_index past the end
   initial_required,     ///< no terra stage and no initial extrinsic
-  stage_not_available,  ///< a stage this build cannot run yet (hots)
+  stage_not_available,  ///< a stage this build cannot run
   terra_failed,         ///< TERRA found no rotation (see terra->status)
-  jeep_failed           ///< JEEP did not converge or its result was rejected (see jeep->status)
+  jeep_failed,          ///< JEEP did not converge or its result was rejected (see jeep->status)
+  hots_failed           ///< the odometry before HOTS or HOTS itself failed (see hots->status)
 };
 
 inline const char* to_string(CalibrateStatus s) {
@@ -42,8 +48,10 @@ inline const char* to_string(CalibrateStatus s) {
       return "stage_not_available";
     case CalibrateStatus::terra_failed:
       return "terra_failed";
-    default:
+    case CalibrateStatus::jeep_failed:
       return "jeep_failed";
+    default:
+      return "hots_failed";
   }
 }
 
@@ -78,9 +86,29 @@ struct JeepReport {
   double seconds = 0.0;
 };
 
+/// The HOTS stage: odometry over every frame from frame_index, then hots::refine.
+struct HotsReport {
+  std::string status;  ///< hots::to_string(RefineStatus), or "not_run" when odometry failed
+  std::string reason;
+  std::string odometry_status;  ///< jeep::to_string(OdometryStatus)
+  std::string odometry_reason;
+  std::size_t frames_base = 0, frames_target = 0;  ///< frames given to odometry and HOTS
+  std::size_t odometry_failed_steps = 0;
+  Isometry3d initial = Isometry3d::Identity();    ///< the extrinsic HOTS started from
+  Isometry3d extrinsic = Isometry3d::Identity();  ///< HOTS's extrinsic (even if failed)
+  double time_offset_s = 0.0;                     ///< t_base_clock = t_target_clock + offset
+  Mat6d covariance_6x6 = Mat6d::Zero();           ///< [rho; phi], left
+  hots::RefineStatistics statistics;
+  std::vector<std::pair<double, double>> spread_curve;  ///< (offset s, spread), last pass
+  double odometry_seconds = 0.0;
+  double seconds = 0.0;  ///< hots::refine alone
+};
+
 struct StageTimings {
   double terra = 0.0;
   double jeep = 0.0;
+  double odometry = 0.0;  ///< the odometry over all frames that feeds HOTS
+  double hots = 0.0;
   double total = 0.0;  ///< the whole call
 };
 
@@ -92,6 +120,10 @@ struct PairCalibration {
   std::vector<Stage> stages;  ///< as asked for
   std::optional<TerraReport> terra;
   std::optional<JeepReport> jeep;
+  std::optional<HotsReport> hots;
+  /// From HOTS when it succeeded; otherwise 0 (clocks assumed synchronised) and no covariance.
+  double time_offset_s = 0.0;
+  std::optional<Mat6d> covariance_6x6;
   StageTimings timing_s;
 
   bool ok() const { return success; }

@@ -1,9 +1,10 @@
 // A PairCalibration as the result file's entry (DESIGN.md, "Result file"; io/result_file.hpp).
 //
 // Conventions this header owns:
-//   - time_offset_s is 0 until the time-sync stage exists (the pipeline assumes synchronised
-//     clocks so far); covariance_6x6 stays null until a stage estimates one.
-//   - "stages" holds one object per stage that ran ("terra", "jeep"); "timing_s" always holds
+//   - time_offset_s and covariance_6x6 come from HOTS when it succeeded; otherwise the offset
+//     is 0 (clocks assumed synchronised) and the covariance null.
+//   - "stages" holds one object per stage that ran ("terra", "jeep", "hots"); "timing_s" always
+//   holds
 //     every stage key of DESIGN.md ("terra", "jeep", "odometry", "hots", "total"), 0 for a
 //     stage that did not run.
 //   - Angles in the stage objects are degrees, distances metres, times seconds.
@@ -80,6 +81,46 @@ inline io::Json jeep_to_json(const JeepReport& r) {
   return j;
 }
 
+/// stages.hots: the odometry that fed it, the graph's and the time synchronisation's statistics
+/// and the spread-against-offset curve.
+inline io::Json hots_to_json(const HotsReport& h) {
+  const hots::RefineStatistics& s = h.statistics;
+  io::Json j = io::Json::object();
+  j["status"] = h.status;
+  j["reason"] = h.reason;
+  j["odometry_status"] = h.odometry_status;
+  j["odometry_reason"] = h.odometry_reason;
+  j["odometry_failed_steps"] = h.odometry_failed_steps;
+  j["frames_base"] = h.frames_base;
+  j["frames_target"] = h.frames_target;
+  j["initial_T_base_target"] = io::matrix_to_json(h.initial.matrix());
+  j["graph_T_base_target"] = io::matrix_to_json(s.graph_extrinsic.matrix());
+  j["windows"] = s.windows;
+  j["failed_windows"] = s.failed_windows;
+  j["planes"] = s.planes;
+  j["ba_factors"] = s.ba_factors;
+  j["cross_links"] = s.cross_links;
+  j["cross_links_attempted"] = s.cross_links_attempted;
+  j["extrinsic_ties"] = s.extrinsic_ties;
+  j["graph_iterations"] = s.graph_iterations;
+  j["graph_initial_cost"] = s.graph_initial_cost;
+  j["graph_cost"] = s.graph_cost;
+  j["time_offset_s"] = h.time_offset_s;
+  j["time_sync_spread"] = s.time_sync_spread;
+  j["time_sync_pairs"] = s.time_sync_pairs;
+  io::Json curve = io::Json::array();
+  for (const auto& [offset, spread] : h.spread_curve) {
+    io::Json point = io::Json::array();
+    point.push_back(offset);
+    point.push_back(spread);
+    curve.push_back(std::move(point));
+  }
+  j["spread_curve"] = std::move(curve);  // [[offset_s, spread], ...]
+  j["odometry_seconds"] = h.odometry_seconds;
+  j["seconds"] = h.seconds;
+  return j;
+}
+
 /// The result-file entry for target `target` against base `base`.
 inline io::PairResult to_pair_result(const PairCalibration& c, const std::string& base,
                                      const std::string& target) {
@@ -90,15 +131,17 @@ inline io::PairResult to_pair_result(const PairCalibration& c, const std::string
   r.status = to_string(c.status);
   r.reason = c.reason;
   r.T_base_target = c.T_base_target;
-  r.time_offset_s = 0.0;
+  r.time_offset_s = c.time_offset_s;
+  if (c.covariance_6x6) r.covariance_6x6 = *c.covariance_6x6;
   r.stages = io::Json::object();
   if (c.terra) r.stages["terra"] = terra_to_json(*c.terra);
   if (c.jeep) r.stages["jeep"] = jeep_to_json(*c.jeep);
+  if (c.hots) r.stages["hots"] = hots_to_json(*c.hots);
   r.timing_s = io::Json::object();
   r.timing_s["terra"] = c.timing_s.terra;
   r.timing_s["jeep"] = c.timing_s.jeep;
-  r.timing_s["odometry"] = 0.0;
-  r.timing_s["hots"] = 0.0;
+  r.timing_s["odometry"] = c.timing_s.odometry;
+  r.timing_s["hots"] = c.timing_s.hots;
   r.timing_s["total"] = c.timing_s.total;
   return r;
 }

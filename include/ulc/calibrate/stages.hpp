@@ -4,7 +4,8 @@
 //   - Stages always run in pipeline order: terra -> jeep -> hots (DESIGN.md, "The house").
 //     A stage list names each stage at most once, in that order; parse_stages says why a list
 //     is not usable instead of reordering it silently.
-//   - "hots" is a known stage name that this build cannot run yet: stage_available() tells.
+//   - stage_available() says whether this build can run a stage (all three can now; it stays
+//     so that a future stage can be named before it lands).
 //   - Nothing here throws (algorithm-header rules).
 #pragma once
 
@@ -26,9 +27,9 @@ inline const char* to_string(Stage s) {
   }
 }
 
-/// Whether this build can run the stage (HOTS lands later).
+/// Whether this build can run the stage.
 inline bool stage_available(Stage s) {
-  return s != Stage::hots;
+  return s == Stage::terra || s == Stage::jeep || s == Stage::hots;
 }
 
 inline bool has_stage(const std::vector<Stage>& stages, Stage s) {

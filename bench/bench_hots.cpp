@@ -1,0 +1,259 @@
+// bench_hots: HOTS (odometry over the whole drive, hierarchical BA, pose graph, time
+// synchronisation) after JEEP, on simulated rig drives (ulc::sim), against the ground truth.
+//
+//   bench_hots --accuracy    [--scenarios 64-32,...] [--seconds 60] [--runs 10]
+//   bench_hots --time-offset [--scenarios 64-32,64-horizon] [--seconds 60] [--runs 10]
+//   common: [--decimation 1] [--threads 2] [--json]
+//
+// Each run simulates the drive with seed = run index + 1, disturbs the truth by 5 deg about a
+// random axis and 2 m in a random direction (seeded by the run), runs JEEP (calibrate_pair,
+// stages jeep, K = 5 pairs from the first frame), then the pipeline's HOTS stage by hand (the
+// same odometry and refine options as ulc::CalibrateOptions' defaults) so that the poses are at
+// hand for the trajectory error. Success: HOTS ok and e_rot < 1 deg and e_trans < 10 cm.
+// Medians are over all runs, failures included. --time-offset runs each scenario with the
+// target's clock 50 ms behind (the paper's figure) and with no offset.
+// ATE: RMS translation error of the base LiDAR's poses (odometry's, then HOTS's) against the
+// simulator's trajectory, both in the base frame at its first timestamp.
+// A 60 s full-rate drive holds every frame in memory (several GB for 64-beam rigs):
+// --decimation N keeps every Nth point.
+#include <tbb/task_arena.h>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "../tests/jeep/jeep_test_util.hpp"
+#include "hots/hots.hpp"
+#include "jeep/run_odometry.hpp"
+#include "support/bench_util.hpp"
+#include "ulc/calibrate.hpp"
+#include "ulc/core/pose_error.hpp"
+#include "ulc/sim/simulate.hpp"
+
+namespace {
+
+using ulc::Isometry3d;
+using ulc_bench::Cell;
+constexpr double kDeg = 3.14159265358979323846 / 180.0;
+
+struct Config {
+  std::string mode = "accuracy";
+  std::vector<std::string> scenarios;
+  double seconds = 60.0;
+  std::size_t runs = 10;
+  unsigned decimation = 1;
+  int threads = 2;
+  ulc_bench::Options bench;
+};
+
+std::vector<std::string> split(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream in(s);
+  std::string item;
+  while (std::getline(in, item, ',')) out.push_back(item);
+  return out;
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// Peak resident memory of this process so far (VmHWM), MiB; 0 when /proc cannot tell.
+double peak_memory_mib() {
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  while (std::getline(status, line))
+    if (line.rfind("VmHWM:", 0) == 0) return std::atof(line.c_str() + 6) / 1024.0;
+  return 0.0;
+}
+
+/// RMS translation error of `est` against the simulator's poses of LiDAR `lidar`, both
+/// expressed in that LiDAR's frame at its first timestamp.
+double ate(const ulc::sim::Dataset& d, std::size_t lidar, const std::vector<Isometry3d>& est) {
+  const auto& t = d.lidars[lidar].timestamps;
+  const Isometry3d origin = jeep_test::lidar_pose(d, lidar, t.front()).inverse();
+  double sum = 0.0;
+  for (std::size_t k = 0; k < t.size(); ++k)
+    sum += ((origin * jeep_test::lidar_pose(d, lidar, t[k])).translation() - est[k].translation())
+               .squaredNorm();
+  return std::sqrt(sum / static_cast<double>(t.size()));
+}
+
+struct Run {
+  bool jeep_ok = false, hots_ok = false;
+  std::string status;
+  ulc::PoseError jeep_error, hots_error;
+  double dt_error_s = 0.0;
+  double ate_odometry = 0.0, ate_hots = 0.0;
+  double odometry_s = 0.0, hots_s = 0.0;
+};
+
+Run one_run(const std::string& scenario, double offset_s, std::size_t run, const Config& c) {
+  Run out;
+  auto spec = *ulc::sim::scenario(scenario);
+  if (offset_s != 0.0) ulc::sim::set_clock_offset(spec, spec.pairs.at(0).target, offset_s);
+  ulc::sim::SimulationOptions so;
+  so.seconds = c.seconds;
+  so.seed = run + 1;
+  so.decimation = c.decimation;
+  const ulc::sim::Dataset d = ulc::sim::simulate(spec, so).dataset;
+  const auto& a = d.lidars.at(0);
+  const auto& b = d.lidars.at(1);
+  const Isometry3d truth = d.pairs.at(0).T_base_target;
+  const double true_offset = d.pairs.at(0).time_offset_s;
+  std::mt19937_64 rng(1000003ULL * (run + 1));
+  const Isometry3d initial = jeep_test::disturbed(truth, rng, 5.0 * kDeg, 2.0);
+
+  tbb::task_arena arena(c.threads);
+  arena.execute([&] {
+    ulc::CalibrateOptions o;
+    o.stages = {ulc::Stage::jeep};
+    o.initial = initial;
+    const auto j = ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, o);
+    out.status = ulc::to_string(j.status);
+    out.jeep_ok = j.success;
+    const Isometry3d C = j.jeep ? j.jeep->extrinsic : initial;
+    out.jeep_error = ulc::pose_error(truth, C);
+    out.hots_error = out.jeep_error;
+    out.dt_error_s = true_offset;
+    if (!j.success) return;
+    auto t0 = std::chrono::steady_clock::now();
+    const auto odo =
+        jeep::run_odometry(a.frames, a.timestamps, b.frames, b.timestamps, C, o.odometry);
+    out.odometry_s = seconds_since(t0);
+    if (!ulc::calibrate_detail::odometry_usable(odo)) {
+      out.status = std::string("odometry_") + jeep::to_string(odo.status);
+      return;
+    }
+    out.ate_odometry = ate(d, 0, odo.poses_a);
+    t0 = std::chrono::steady_clock::now();
+    const auto h = hots::refine(a.frames, a.timestamps, odo.poses_a, b.frames, b.timestamps,
+                                odo.poses_b, C, o.hots);
+    out.hots_s = seconds_since(t0);
+    out.status = std::string("hots_") + hots::to_string(h.status);
+    out.hots_ok = h.ok();
+    if (!h.ok()) return;
+    out.hots_error = ulc::pose_error(truth, h.extrinsic);
+    out.dt_error_s = h.time_offset_s - true_offset;
+    out.ate_hots = ate(d, 0, h.poses_a);
+  });
+  return out;
+}
+
+void emit(const ulc_bench::Table& table, const std::string& name, const Config& c,
+          const std::vector<std::pair<std::string, Cell>>& parameters,
+          const std::vector<std::pair<std::string, Cell>>& notes) {
+  if (c.bench.json) {
+    table.write_json(std::cout, name, ulc_bench::machine(), 1, parameters, notes);
+  } else {
+    table.print(std::cout);
+    for (const auto& n : notes) std::cout << n.first << ": " << n.second.text << "\n";
+  }
+}
+
+void bench(Config c) {
+  const bool offsets = c.mode == "time-offset";
+  if (c.scenarios.empty())
+    c.scenarios = offsets ? std::vector<std::string>{"64-32", "64-horizon"}
+                          : std::vector<std::string>{"64-32",      "32-16",   "horizon-tele",
+                                                     "64-horizon", "32-avia", "64-tele"};
+  const std::vector<double> offset_list =
+      offsets ? std::vector<double>{0.05, 0.0} : std::vector<double>{0.0};
+  ulc_bench::Table table({"scenario", "offset_ms", "runs", "jeep_success_pct", "hots_success_pct",
+                          "jeep_e_rot_deg", "hots_e_rot_deg", "jeep_e_trans_cm", "hots_e_trans_cm",
+                          "dt_error_ms", "ate_odometry_cm", "ate_hots_cm", "odometry_s", "hots_s"});
+  for (const auto& scenario : c.scenarios) {
+    if (!ulc::sim::scenario(scenario)) {
+      std::cerr << "bench_hots: unknown scenario '" << scenario << "'\n";
+      std::exit(2);
+    }
+    for (const double offset : offset_list) {
+      std::vector<double> jr, hr, jt, ht, dt, ao, ah, so, sh;
+      std::size_t jeep_ok = 0, hots_ok = 0;
+      for (std::size_t run = 0; run < c.runs; ++run) {
+        const Run r = one_run(scenario, offset, run, c);
+        const bool j_success = r.jeep_ok && ulc::is_calibration_success(r.jeep_error);
+        const bool h_success = r.hots_ok && ulc::is_calibration_success(r.hots_error);
+        jeep_ok += j_success ? 1 : 0;
+        hots_ok += h_success ? 1 : 0;
+        jr.push_back(r.jeep_error.rotation_deg);
+        hr.push_back(r.hots_error.rotation_deg);
+        jt.push_back(r.jeep_error.translation_m);
+        ht.push_back(r.hots_error.translation_m);
+        dt.push_back(std::abs(r.dt_error_s));
+        ao.push_back(r.ate_odometry);
+        ah.push_back(r.ate_hots);
+        so.push_back(r.odometry_s);
+        sh.push_back(r.hots_s);
+        if (!c.bench.json)
+          std::cerr << "  " << scenario << " offset " << offset * 1e3 << " ms run " << run << ": "
+                    << r.status << "; JEEP " << r.jeep_error.rotation_deg << " deg "
+                    << r.jeep_error.translation_m * 100 << " cm; HOTS " << r.hots_error.rotation_deg
+                    << " deg " << r.hots_error.translation_m * 100 << " cm, dt error "
+                    << r.dt_error_s * 1e3 << " ms, ATE " << r.ate_odometry * 100 << " -> "
+                    << r.ate_hots * 100 << " cm (" << r.odometry_s << " + " << r.hots_s << " s)\n";
+      }
+      const double n = static_cast<double>(c.runs);
+      using jeep_test::median;
+      table.add_row(
+          {scenario, Cell::num(offset * 1e3, 0), Cell::integer(static_cast<long long>(c.runs)),
+           Cell::num(100.0 * static_cast<double>(jeep_ok) / n, 1),
+           Cell::num(100.0 * static_cast<double>(hots_ok) / n, 1), Cell::num(median(jr), 4),
+           Cell::num(median(hr), 4), Cell::num(100 * median(jt), 2), Cell::num(100 * median(ht), 2),
+           Cell::num(1e3 * median(dt), 2), Cell::num(100 * median(ao), 2),
+           Cell::num(100 * median(ah), 2), Cell::num(median(so), 2), Cell::num(median(sh), 2)});
+    }
+  }
+  std::string list;
+  for (const auto& s : c.scenarios) list += (list.empty() ? "" : ",") + s;
+  emit(table, offsets ? "bench_hots_time_offset" : "bench_hots_accuracy", c,
+       {{"scenarios", list},
+        {"seconds", Cell::num(c.seconds, 1)},
+        {"runs", Cell::integer(static_cast<long long>(c.runs))},
+        {"decimation", Cell::integer(c.decimation)},
+        {"threads", Cell::integer(c.threads)},
+        {"disturbance", "5 deg about a random axis, 2 m in a random direction, before JEEP"}},
+       {{"success", "status ok and e_rot < 1 deg and e_trans < 10 cm"},
+        {"medians", "over all runs, failures included (a failed HOTS counts JEEP's error)"},
+        {"dt_error", "|estimated - true clock offset|; the true offset when HOTS did not run"},
+        {"peak_memory_mib", Cell::num(peak_memory_mib(), 0)}});
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Config c;
+  std::vector<char*> rest = {argv[0]};
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    const bool value = i + 1 < argc;
+    if (a == "--accuracy" || a == "--time-offset") {
+      c.mode = a.substr(2);
+    } else if (a == "--scenarios" && value) {
+      c.scenarios = split(argv[++i]);
+    } else if (a == "--seconds" && value) {
+      c.seconds = std::atof(argv[++i]);
+    } else if (a == "--runs" && value) {
+      c.runs = std::max<std::size_t>(1, std::strtoul(argv[++i], nullptr, 10));
+    } else if (a == "--decimation" && value) {
+      c.decimation = static_cast<unsigned>(std::max(1, std::atoi(argv[++i])));
+    } else if (a == "--threads" && value) {
+      c.threads = std::max(1, std::atoi(argv[++i]));
+    } else {
+      rest.push_back(argv[i]);
+    }
+  }
+  c.bench = ulc_bench::parse_options(static_cast<int>(rest.size()), rest.data(),
+                                     "HOTS after JEEP on simulated drives (modes: --accuracy "
+                                     "--time-offset; options --scenarios --seconds --runs "
+                                     "--decimation --threads)");
+  bench(c);
+  return 0;
+}

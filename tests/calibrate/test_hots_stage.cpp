@@ -1,0 +1,127 @@
+// The HOTS stage of ulc::calibrate_pair: the full pipeline terra,jeep,hots recovers the 64-32
+// mounting on a short simulated drive and its result entry carries HOTS's clock offset and
+// covariance; a failing odometry or HOTS ends the call with hots_failed and keeps the extrinsic
+// HOTS started from.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "calibrate_test_util.hpp"
+#include "ulc/calibrate.hpp"
+#include "ulc/calibrate/result_entry.hpp"
+#include "ulc/core/pose_error.hpp"
+#include "ulc/io/result_file.hpp"
+
+using namespace calibrate_test;
+using ulc::CalibrateStatus;
+using ulc::Stage;
+
+TEST_CASE("terra,jeep,hots recovers the 64-32 mounting and a clock offset", "[calibrate][hots]") {
+  const auto& d = drive_64_32_hots();
+  const auto& a = d.lidars[0];
+  const auto& b = d.lidars[1];
+  REQUIRE(a.frames.size() >= 25);
+  const ulc::Isometry3d truth = d.pairs[0].T_base_target;
+  std::vector<std::string> stages_seen;
+  ulc::CalibrateOptions o;  // the default stages: terra, jeep, hots
+  REQUIRE(o.stages == std::vector<Stage>{Stage::terra, Stage::jeep, Stage::hots});
+  o.progress = [&](const std::string& stage, double) {
+    if (stages_seen.empty() || stages_seen.back() != stage) stages_seen.push_back(stage);
+  };
+  const auto c = ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, o);
+  INFO(ulc::to_string(c.status) << ": " << c.reason);
+  REQUIRE(c.success);
+  REQUIRE(c.jeep);
+  REQUIRE(c.hots);
+  const auto e = ulc::pose_error(truth, c.T_base_target);
+  const auto ej = ulc::pose_error(truth, c.jeep->extrinsic);
+  INFO("HOTS e_rot " << e.rotation_deg << " deg, e_trans " << e.translation_m << " m; JEEP "
+                     << ej.rotation_deg << " deg, " << ej.translation_m << " m; offset "
+                     << c.time_offset_s << " s");
+  CHECK(e.rotation_deg < 1.0);
+  CHECK(e.translation_m < 0.10);
+
+  // HOTS started from JEEP's extrinsic, over every frame, and its outputs are the result's.
+  const auto& h = *c.hots;
+  CHECK(h.status == "ok");
+  CHECK(same_bits(h.initial, c.jeep->extrinsic));
+  CHECK(same_bits(h.extrinsic, c.T_base_target));
+  CHECK(h.frames_base == a.frames.size());
+  CHECK(h.frames_target == b.frames.size());
+  CHECK(h.statistics.windows > 0);
+  CHECK(h.statistics.planes > 0);
+  CHECK(!h.spread_curve.empty());
+  CHECK(std::abs(c.time_offset_s) < 0.02);  // the simulated clocks agree
+  CHECK(c.time_offset_s == h.time_offset_s);
+  REQUIRE(c.covariance_6x6);
+  CHECK(c.covariance_6x6->allFinite());
+  CHECK(c.covariance_6x6->trace() > 0.0);
+  CHECK(c.timing_s.odometry > 0.0);
+  CHECK(c.timing_s.hots > 0.0);
+  CHECK(stages_seen == std::vector<std::string>{"terra", "jeep", "odometry", "hots"});
+
+  // The result entry, through the file format and back.
+  const ulc::io::PairResult r = ulc::to_pair_result(c, "lidar64", "lidar32");
+  const auto json = ulc::io::results_to_json({r});
+  const auto back = ulc::io::results_from_json(ulc::io::parse_json(json.dump()), "<test>");
+  REQUIRE(back.size() == 1);
+  REQUIRE(back[0].time_offset_s);
+  CHECK(*back[0].time_offset_s == Approx(c.time_offset_s).margin(1e-12));
+  REQUIRE(back[0].covariance_6x6);
+  CHECK(back[0].covariance_6x6->isApprox(*c.covariance_6x6, 1e-12));
+  CHECK(back[0].timing_s.at("odometry").as_number() == c.timing_s.odometry);
+  CHECK(back[0].timing_s.at("hots").as_number() == c.timing_s.hots);
+  const auto& hj = back[0].stages.at("hots");
+  CHECK(hj.at("status").as_string() == "ok");
+  CHECK(hj.at("windows").as_number() == static_cast<double>(h.statistics.windows));
+  CHECK(hj.at("planes").as_number() == static_cast<double>(h.statistics.planes));
+  CHECK(hj.at("graph_iterations").as_number() == h.statistics.graph_iterations);
+  CHECK(hj.at("graph_cost").as_number() == Approx(h.statistics.graph_cost));
+  CHECK(hj.at("time_sync_spread").as_number() == Approx(h.statistics.time_sync_spread));
+  CHECK(hj.at("spread_curve").size() == h.spread_curve.size());
+}
+
+TEST_CASE("a failing odometry or HOTS gives hots_failed and keeps the extrinsic it started from",
+          "[calibrate][hots][status]") {
+  const auto& d = drive_64_32();
+  const auto& a = d.lidars[0];
+  const auto& b = d.lidars[1];
+  ulc::CalibrateOptions o;
+  o.stages = {Stage::hots};
+  o.initial = disturbed(d.pairs[0].T_base_target, 5, 0.5 * kDeg, 0.05);
+
+  o.odometry.max_pair_gap = -1.0;  // refused by the odometry before any work
+  const auto odometry_failed =
+      ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, o);
+  INFO(odometry_failed.reason);
+  CHECK(odometry_failed.status == CalibrateStatus::hots_failed);
+  CHECK_FALSE(odometry_failed.success);
+  CHECK_THAT(odometry_failed.reason, Catch::Contains("HOTS: odometry: invalid_input"));
+  REQUIRE(odometry_failed.hots);
+  CHECK(odometry_failed.hots->status == "not_run");
+  CHECK(same_bits(odometry_failed.T_base_target, *o.initial));
+  CHECK(!odometry_failed.covariance_6x6);
+
+  o.odometry = {};
+  o.hots.passes = 0;  // refused by hots::refine after the odometry ran
+  const auto hots_failed = ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, o);
+  INFO(hots_failed.reason);
+  CHECK(hots_failed.status == CalibrateStatus::hots_failed);
+  CHECK_FALSE(hots_failed.success);
+  CHECK_THAT(hots_failed.reason, Catch::Contains("HOTS: invalid_input"));
+  REQUIRE(hots_failed.hots);
+  CHECK(hots_failed.hots->odometry_status == "ok");
+  CHECK(hots_failed.hots->status == "invalid_input");
+  CHECK(same_bits(hots_failed.T_base_target, *o.initial));
+  CHECK(hots_failed.time_offset_s == 0.0);
+  const auto entry = ulc::to_pair_result(hots_failed, "lidar64", "lidar32");
+  CHECK(entry.status == "hots_failed");
+  CHECK(!entry.covariance_6x6);
+  CHECK(entry.stages.at("hots").at("status").as_string() == "invalid_input");
+
+  // Without terra, hots alone needs a guess.
+  o.initial.reset();
+  CHECK(ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, o).status ==
+        CalibrateStatus::initial_required);
+}
