@@ -10,13 +10,16 @@
 #include <vector>
 
 #include "calibrate_frames.hpp"
+#include "calibration_report.hpp"
 #include "cli_args.hpp"
 #include "commands.hpp"
+#include "fused_cloud.hpp"
 #include "initial_extrinsic.hpp"
 #include "progress.hpp"
 #include "ulc/calibrate.hpp"
 #include "ulc/calibrate/result_entry.hpp"
 #include "ulc/io/result_file.hpp"
+#include "ulc/io/result_yaml.hpp"
 #include "ulc/io/sequence.hpp"
 
 namespace ulc::app {
@@ -61,6 +64,10 @@ void require_output_folder(const std::string& output) {
     throw cli::UsageError("calibrate: --output " + output + ": no such folder " + folder.string());
 }
 
+std::vector<Eigen::Vector3f> points_of(const PointCloud<float>& cloud) {
+  return std::vector<Eigen::Vector3f>(cloud.points.begin(), cloud.points.end());
+}
+
 void print_summary(const io::PairResult& r) {
   std::printf("%s <- %s: %s%s%s\n", r.base.c_str(), r.target.c_str(), r.status.c_str(),
               r.reason.empty() ? "" : ": ", r.reason.c_str());
@@ -83,6 +90,11 @@ int run_calibrate(int argc, char** argv) {
   args.option("base", "PATH", "the base LiDAR: a frame folder or one frame file", true)
       .option("target", "PATH", "a target LiDAR: a frame folder or one frame file", true, true)
       .option("output", "FILE", "write the result file (DESIGN.md) here")
+      .option("format", "json|yaml",
+              "format of --output (default json; yaml adds ROS and URDF forms of each extrinsic)")
+      .option("merged-cloud", "PCD",
+              "write every LiDAR's first used frame in the base frame, one colour per LiDAR")
+      .option("report", "PNG", "draw the fused frames before (initial guess) and after calibration")
       .option("stages", "LIST", "an ordered subset of terra,jeep,hots (default terra,jeep,hots)")
       .option("initial", "GUESS",
               "\"x y z roll pitch yaw\" (m, deg; R = Rz Ry Rx) or a result file; needed when "
@@ -124,7 +136,12 @@ int run_calibrate(int argc, char** argv) {
   std::optional<tbb::task_arena> arena;
   if (args.has("threads")) arena.emplace(static_cast<int>(args.get_int("threads", 1, 1, 1024)));
   if (!run_terra) (void)parse_initial(args.get("initial"), "", "");  // fail before any loading
-  if (args.has("output")) require_output_folder(args.get("output"));
+  const std::string format = args.get("format", "json");
+  if (format != "json" && format != "yaml")
+    throw cli::UsageError("calibrate: option '--format': expected json or yaml, got '" + format +
+                          "'");
+  for (const char* file_option : {"output", "merged-cloud", "report"})
+    if (args.has(file_option)) require_output_folder(args.get(file_option));
 
   const io::Sequence base(args.get("base"));
   std::vector<io::Sequence> targets;
@@ -141,6 +158,9 @@ int run_calibrate(int argc, char** argv) {
   const LoadedFrames base_frames = load_frames(base, frame_index, base_count);
 
   std::vector<io::PairResult> results;
+  std::vector<FusedPart> fused{{points_of(base_frames.clouds.front()), Isometry3d::Identity()}};
+  std::vector<ReportCloud> report{
+      {base.name(), fused.front().points, Isometry3d::Identity(), Isometry3d::Identity()}};
   for (const auto& target : targets) {
     const std::size_t count = run_hots   ? target.size() - frame_index
                               : run_jeep ? covering_count(base, target, base_count)
@@ -159,13 +179,32 @@ int run_calibrate(int argc, char** argv) {
     const PairCalibration c = arena ? arena->execute(run) : run();
     io::PairResult r = to_pair_result(c, base.name(), target.name());
     if (r.stages.find("terra")) r.stages["terra"]["frame_index"] = frame_index;
+    if (args.has("merged-cloud") || args.has("report")) {
+      // Pictures show the calibrated frames only when they are worth showing; a failed target is
+      // drawn where its guess put it, in both panels.
+      const Isometry3d before = pair_options.initial.value_or(Isometry3d::Identity());
+      const Isometry3d after = r.success ? r.T_base_target : before;
+      fused.push_back({points_of(target_frames.clouds.front()), after});
+      report.push_back({target.name(), fused.back().points, before, after});
+    }
     results.push_back(std::move(r));
     print_summary(results.back());
   }
 
   if (args.has("output")) {
-    io::write_result_file(args.get("output"), results);
+    if (format == "yaml")
+      io::write_result_yaml(args.get("output"), results);
+    else
+      io::write_result_file(args.get("output"), results);
     std::printf("wrote %s\n", args.get("output").c_str());
+  }
+  if (args.has("merged-cloud")) {
+    write_fused_cloud(args.get("merged-cloud"), fused);
+    std::printf("wrote %s\n", args.get("merged-cloud").c_str());
+  }
+  if (args.has("report")) {
+    write_calibration_report(args.get("report"), report);
+    std::printf("wrote %s\n", args.get("report").c_str());
   }
   for (const auto& r : results)
     if (!r.success) return kExitFailed;

@@ -177,6 +177,65 @@ TEST_CASE("ulc calibrate --stages jeep takes --initial as numbers or a result fi
   CHECK(evaluate_success(d, from_file));
 }
 
+TEST_CASE("ulc calibrate --format yaml, --merged-cloud and --report write what they promise",
+          "[app][calibrate]") {
+  const Dataset d("ulc_test_calibrate_outputs");
+  Eigen::Isometry3d guess = true_extrinsic(d);
+  guess.translation() += Eigen::Vector3d(0.2, 0.1, -0.1);
+  const std::string yaml = d.file("result.yaml"), fused = d.file("fused.pcd"),
+                    report = d.file("report.png");
+  const auto run = run_command(kUlc + " calibrate --quiet" + d.pair_args() +
+                               " --stages jeep --frames 4 --initial " + quote(xyz_rpy(guess)) +
+                               " --format yaml --output " + quote(yaml) + " --merged-cloud " +
+                               quote(fused) + " --report " + quote(report));
+  INFO(run.output);
+  REQUIRE(run.exit_code == 0);
+
+  // YAML: the matrix rows follow T_base_target and give the calibrated transform.
+  std::FILE* f = std::fopen(yaml.c_str(), "rb");
+  REQUIRE(f);
+  std::string text(1 << 16, '\0');
+  text.resize(std::fread(text.data(), 1, text.size(), f));
+  std::fclose(f);
+  CHECK(text.find("static_transform_publisher: ") != std::string::npos);
+  CHECK(text.find("<parent link=\"lidar64\"/>") != std::string::npos);
+  const auto at = text.find("translation_m: [");
+  REQUIRE(at != std::string::npos);
+  Eigen::Vector3d t;
+  REQUIRE(std::sscanf(text.c_str() + at, "translation_m: [%lf, %lf, %lf]", &t.x(), &t.y(),
+                      &t.z()) == 3);
+  CHECK((t - true_extrinsic(d).translation()).norm() < 0.1);
+
+  // Fused cloud: both LiDARs' first frames, the target's moved onto the base's surfaces.
+  const auto base =
+      ulc::io::read_pcd<std::vector<Eigen::Vector3f>>((d.dir / "lidar64" / "000000.pcd").string());
+  const auto target =
+      ulc::io::read_pcd<std::vector<Eigen::Vector3f>>((d.dir / "lidar32" / "000000.pcd").string());
+  const auto merged = ulc::io::read_pcd<std::vector<Eigen::Vector3f>>(fused);
+  REQUIRE(merged.size() == base.size() + target.size());
+  CHECK(merged.front().isApprox(base.front()));
+  const Eigen::Isometry3f T = true_extrinsic(d).cast<float>();
+  CHECK((merged[base.size()] - T * target.front()).norm() < 0.1f);
+
+  // Report: a PNG file (signature) of non-trivial size.
+  std::FILE* png = std::fopen(report.c_str(), "rb");
+  REQUIRE(png);
+  unsigned char signature[8] = {};
+  CHECK(std::fread(signature, 1, 8, png) == 8);
+  std::fseek(png, 0, SEEK_END);
+  CHECK(std::ftell(png) > 10000);
+  std::fclose(png);
+  CHECK(signature[1] == 'P');
+  CHECK(signature[2] == 'N');
+  CHECK(signature[3] == 'G');
+
+  // A format that does not exist is bad usage.
+  const auto bad = run_command(kUlc + " calibrate --quiet" + d.pair_args() +
+                               " --stages terra --format xml --output " + quote(yaml));
+  CHECK(bad.exit_code == 2);
+  CHECK(bad.output.find("--format") != std::string::npos);
+}
+
 TEST_CASE("ulc calibrate --stages hots is accepted and runs odometry and HOTS over every frame",
           "[app][calibrate][hots]") {
   const Dataset d("ulc_test_calibrate_hots");
