@@ -75,7 +75,8 @@ void print_summary(const io::PairResult& r) {
   const Eigen::Vector3d rpy = ulc::rpy_from_rotation(r.T_base_target.linear()) * kDeg;
   std::printf("  xyz_m   %9.4f %9.4f %9.4f\n", t.x(), t.y(), t.z());
   std::printf("  rpy_deg %9.3f %9.3f %9.3f\n", rpy.x(), rpy.y(), rpy.z());
-  if (r.stages.find("hots"))
+  if (const io::Json* hots = r.stages.find("hots");
+      hots && hots->at("status").as_string() != "skipped")
     std::printf("  time_offset_ms %.2f\n", r.time_offset_s ? *r.time_offset_s * 1e3 : 0.0);
   std::printf("  time_s  terra %.2f  jeep %.2f  odometry %.2f  hots %.2f  total %.2f\n",
               r.timing_s.at("terra").as_number(), r.timing_s.at("jeep").as_number(),

@@ -22,7 +22,9 @@
 //     and poses. Its extrinsic, clock offset and covariance become the result's. An odometry
 //     that could not register some frames still feeds HOTS (its poses are predictions there;
 //     the report counts them); an odometry that gives no poses, or a HOTS that fails, ends the
-//     call with hots_failed, keeping the previous extrinsic.
+//     call with hots_failed, keeping the previous extrinsic. With fewer than
+//     hots_min_frames frames per LiDAR (single frames, as in a static rig's snapshot) HOTS is
+//     skipped after TERRA or JEEP: stages.hots has status "skipped" and the reason.
 //   - Progress: options.progress(stage, fraction in [0, 1]) on the calling thread; stages
 //     "terra", "jeep", "odometry", "hots" (HOTS reports only 0 and 1).
 //   - Threads: every stage is deterministic for any thread count, so is this. Run inside a
@@ -60,6 +62,10 @@ struct CalibrateOptions {
   jeep::OdometryOptions odometry;  ///< the odometry over all frames that feeds HOTS
   hots::RefineOptions hots;        ///< windows of 5, 3 layers, time synchronisation on
   std::vector<Stage> stages{Stage::terra, Stage::jeep, Stage::hots};
+  /// Single frames or a static rig (fewer frames than this per LiDAR from frame_index): HOTS
+  /// has no motion to work with, so after TERRA or JEEP it is skipped (stages.hots says so) and
+  /// their extrinsic is the answer; as the only stage it fails.
+  std::size_t hots_min_frames = 10;
   std::size_t frame_index = 0;        ///< TERRA's frame, and the first frame of the others
   std::optional<Isometry3d> initial;  ///< T_base_target guess, used when terra does not run
   CalibrateProgress progress;         ///< optional
@@ -229,7 +235,15 @@ PairCalibration calibrate_pair(const FramesA& frames_a, const std::vector<double
     r.T_base_target = C;
   }
 
-  if (run_hots) {
+  const std::size_t frames_left = std::min(frames_a.size(), frames_b.size()) - i;
+  if (run_hots && frames_left < options.hots_min_frames && (run_terra || run_jeep)) {
+    r.hots = HotsReport{};
+    r.hots->status = "skipped";
+    r.hots->reason = "only " + std::to_string(frames_left) + " frame(s) per LiDAR from frame " +
+                     std::to_string(i) + " (HOTS needs " + std::to_string(options.hots_min_frames) +
+                     " of a moving rig); the extrinsic is the previous stage's";
+    r.hots->initial = r.hots->extrinsic = C;
+  } else if (run_hots) {
     const FrameRange<FramesA> view_a(frames_a, i);
     const FrameRange<FramesB> view_b(frames_b, i);
     const std::vector<double> ta = times_from(times_a, i), tb = times_from(times_b, i);

@@ -356,3 +356,33 @@ TEST_CASE("real sample: TERRA finds both side LiDARs of croon_0003 with no guess
     CHECK(e.rotation_deg < 5.0);
   }
 }
+
+TEST_CASE(
+    "real sample: the default stages calibrate croon_0003's single frames within 1 deg and "
+    "10 cm, HOTS skipped",
+    "[app][calibrate][real]") {
+  const auto dir = ulc_test::croon_dir();
+  ULC_SKIP_UNLESS(!dir.empty(), "croon_0003 sample not found next to the checkout");
+  const fs::path out = fs::temp_directory_path() / "ulc_test_calibrate_croon_all.json";
+  const auto run =
+      run_command(kUlc + " calibrate --quiet --base " + quote((dir / "top.pcd").string()) +
+                  " --target " + quote((dir / "left.pcd").string()) + " --target " +
+                  quote((dir / "right.pcd").string()) + " --output " + quote(out.string()));
+  INFO(run.output);
+  REQUIRE(run.exit_code == 0);
+  const auto results = ulc::io::read_result_file(out.string());
+  fs::remove(out);
+  const auto gt = ulc::io::read_ground_truth((dir / "ground_truth.json").string());
+  REQUIRE(results.size() == 2);
+  for (const auto& r : results) {
+    const auto* truth = gt.find_pair(r.base, r.target);
+    REQUIRE(truth);
+    const auto e = ulc::pose_error(truth->T_base_target, r.T_base_target);
+    INFO(r.base << " <- " << r.target << ": e_rot " << e.rotation_deg << " deg, e_trans "
+                << e.translation_m << " m");
+    CHECK(r.success);
+    CHECK(r.stages.at("hots").at("status").as_string() == "skipped");
+    CHECK(e.rotation_deg < 1.0);
+    CHECK(e.translation_m < 0.10);
+  }
+}
