@@ -333,13 +333,13 @@ TEST_CASE("ulc calibrate reports bad usage and unreadable input with exit code 2
   CHECK_THAT(help.output, Catch::Contains("--initial") && Catch::Contains("--frame-index"));
 }
 
-TEST_CASE("real sample: TERRA finds both side LiDARs of croon_0003 with no guess",
-          "[app][calibrate][real]") {
-  const auto dir = ulc_test::croon_dir();
-  ULC_SKIP_UNLESS(!dir.empty(), "croon_0003 sample not found next to the checkout");
+/// `ulc calibrate <extra> --base top --target left --target right` on croon_0003: each result
+/// with its error against the shipped calibration.
+std::vector<std::pair<ulc::io::PairResult, ulc::PoseError>> calibrate_croon(
+    const fs::path& dir, const std::string& extra) {
   const fs::path out = fs::temp_directory_path() / "ulc_test_calibrate_croon.json";
   const auto run = run_command(
-      kUlc + " calibrate --quiet --stages terra --base " + quote((dir / "top.pcd").string()) +
+      kUlc + " calibrate --quiet" + extra + " --base " + quote((dir / "top.pcd").string()) +
       " --target " + quote((dir / "left.pcd").string()) + " --target " +
       quote((dir / "right.pcd").string()) + " --output " + quote(out.string()));
   INFO(run.output);
@@ -348,10 +348,20 @@ TEST_CASE("real sample: TERRA finds both side LiDARs of croon_0003 with no guess
   fs::remove(out);
   const auto gt = ulc::io::read_ground_truth((dir / "ground_truth.json").string());
   REQUIRE(results.size() == 2);
+  std::vector<std::pair<ulc::io::PairResult, ulc::PoseError>> out_pairs;
   for (const auto& r : results) {
     const auto* truth = gt.find_pair(r.base, r.target);
     REQUIRE(truth);
-    const auto e = ulc::pose_error(truth->T_base_target, r.T_base_target);
+    out_pairs.emplace_back(r, ulc::pose_error(truth->T_base_target, r.T_base_target));
+  }
+  return out_pairs;
+}
+
+TEST_CASE("real sample: TERRA finds both side LiDARs of croon_0003 with no guess",
+          "[app][calibrate][real]") {
+  const auto dir = ulc_test::croon_dir();
+  ULC_SKIP_UNLESS(!dir.empty(), "croon_0003 sample not found next to the checkout");
+  for (const auto& [r, e] : calibrate_croon(dir, " --stages terra")) {
     INFO(r.base << " <- " << r.target << ": e_rot " << e.rotation_deg << " deg");
     CHECK(e.rotation_deg < 5.0);
   }
@@ -363,21 +373,7 @@ TEST_CASE(
     "[app][calibrate][real]") {
   const auto dir = ulc_test::croon_dir();
   ULC_SKIP_UNLESS(!dir.empty(), "croon_0003 sample not found next to the checkout");
-  const fs::path out = fs::temp_directory_path() / "ulc_test_calibrate_croon_all.json";
-  const auto run =
-      run_command(kUlc + " calibrate --quiet --base " + quote((dir / "top.pcd").string()) +
-                  " --target " + quote((dir / "left.pcd").string()) + " --target " +
-                  quote((dir / "right.pcd").string()) + " --output " + quote(out.string()));
-  INFO(run.output);
-  REQUIRE(run.exit_code == 0);
-  const auto results = ulc::io::read_result_file(out.string());
-  fs::remove(out);
-  const auto gt = ulc::io::read_ground_truth((dir / "ground_truth.json").string());
-  REQUIRE(results.size() == 2);
-  for (const auto& r : results) {
-    const auto* truth = gt.find_pair(r.base, r.target);
-    REQUIRE(truth);
-    const auto e = ulc::pose_error(truth->T_base_target, r.T_base_target);
+  for (const auto& [r, e] : calibrate_croon(dir, "")) {
     INFO(r.base << " <- " << r.target << ": e_rot " << e.rotation_deg << " deg, e_trans "
                 << e.translation_m << " m");
     CHECK(r.success);
