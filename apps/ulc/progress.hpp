@@ -45,7 +45,7 @@ class Progress {
   std::string stage_;
   bool quiet_;
   bool terminal_;
-  int last_percent_ = -1;
+  int last_percent_ = -100;  // no decile yet: the first update always prints (-1 / 10 == 0)
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
 };
 
