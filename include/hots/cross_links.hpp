@@ -10,6 +10,12 @@
 //     T_anchor_b: source = b's member cloud, target = a's member cloud with per-point planes.
 //     Its information is the registration's Hessian (left perturbation in a's anchor frame,
 //     exactly the pose-graph residual's tangent) over sigma^2, sigma = max(rmse, min_sigma).
+//   - Both clouds are voxel-downsampled before the registration (source_voxel for b's,
+//     target_voxel for a's planes): a few thousand well-spread points fix a 6-DoF pose, and
+//     the link's cost (a's kd-trees and normals, b's matches) is linear in them. Measured on
+//     bench_hots (64-32): 2.3x faster and no less accurate than the 0.1 m frames; the
+//     information (Hessian of fewer points) is smaller, which weights links less against the
+//     windows' BA; accuracy did not suffer from that (scaling it back up was worse).
 //   - A link is kept when the registration is ok and its inlier ratio >= min_inlier_ratio.
 //   - Registrations run as TBB tasks, one slot each; the kept links are in (layer, a member)
 //     order. Nothing here throws or prints.
@@ -17,6 +23,7 @@
 
 #include <cmath>
 #include <cstddef>
+#include <utility>
 #include <vector>
 
 #include <tbb/blocked_range.h>
@@ -25,12 +32,15 @@
 #include "hots/hierarchy.hpp"
 #include "ulc/core/point_to_plane.hpp"
 #include "ulc/core/registration_target.hpp"
+#include "ulc/core/voxel_downsample.hpp"
 
 namespace hots {
 
 struct CrossLinkOptions {
   int min_layer = 0;              ///< layers min_layer .. top are linked
   std::size_t layer0_stride = 1;  ///< at layer 0, every n-th a frame
+  double source_voxel = 0.5;      ///< m, b's cloud (registered points) thinning; 0: none
+  double target_voxel = 0.3;      ///< m, a's cloud (planes) thinning; 0: none
   double gate = 1.0;              ///< first registration stage's gate, m
   double min_inlier_ratio = 0.3;
   double min_sigma = 0.01;  ///< m
@@ -57,6 +67,17 @@ inline std::size_t nearest(const std::vector<double>& member_times, double t) {
   for (std::size_t i = 1; i < member_times.size(); ++i)
     if (std::abs(member_times[i] - t) < std::abs(member_times[best] - t)) best = i;
   return best;
+}
+
+/// The cloud voxel-downsampled into `storage` when voxel > 0 and that works; else the cloud.
+template <typename S>
+const std::vector<ulc::Vec3<S>>& thinned(const std::vector<ulc::Vec3<S>>& cloud, double voxel,
+                                         std::vector<ulc::Vec3<S>>& storage) {
+  if (!(voxel > 0.0)) return cloud;
+  auto down = ulc::voxel_downsample(cloud, voxel);
+  if (!down.ok()) return cloud;
+  storage = std::move(down.cloud.points);
+  return storage;
 }
 
 }  // namespace cross_link_detail
@@ -90,11 +111,15 @@ std::vector<CrossLink> cross_links(
                           const auto& cloud_a = l == 0 ? frames_a[a.begin] : a.cloud;
                           const auto& cloud_b = l == 0 ? frames_b[b.begin] : b.cloud;
                           if (cloud_a.empty() || cloud_b.empty()) continue;
-                          const ulc::PlaneCloud<S> target(cloud_a, options.planes);
+                          std::vector<ulc::Vec3<S>> thin_a, thin_b;
+                          const ulc::PlaneCloud<S> target(
+                              cross_link_detail::thinned(cloud_a, options.target_voxel, thin_a),
+                              options.planes);
                           if (target.empty()) continue;
                           const Isometry3d initial = poses_a[a.begin].inverse() * poses_b[b.begin];
-                          const auto reg =
-                              ulc::register_point_to_plane(cloud_b, target, initial, stages);
+                          const auto reg = ulc::register_point_to_plane(
+                              cross_link_detail::thinned(cloud_b, options.source_voxel, thin_b),
+                              target, initial, stages);
                           if (!reg.ok() || reg.inlier_ratio() < options.min_inlier_ratio) continue;
                           CrossLink& link = slot[c];
                           link.frame_a = a.begin;
