@@ -53,14 +53,6 @@ struct Config {
   ulc_bench::Options bench;
 };
 
-std::vector<std::string> split(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream in(s);
-  std::string item;
-  while (std::getline(in, item, ',')) out.push_back(item);
-  return out;
-}
-
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -237,7 +229,7 @@ int main(int argc, char** argv) {
     if (a == "--accuracy" || a == "--time-offset") {
       c.mode = a.substr(2);
     } else if (a == "--scenarios" && value) {
-      c.scenarios = split(argv[++i]);
+      c.scenarios = ulc_bench::split_list(argv[++i]);
     } else if (a == "--seconds" && value) {
       c.seconds = std::atof(argv[++i]);
     } else if (a == "--runs" && value) {

@@ -67,14 +67,6 @@ struct Config {
   ulc_bench::Options bench;
 };
 
-std::vector<std::string> split(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream in(s);
-  std::string item;
-  while (std::getline(in, item, ',')) out.push_back(item);
-  return out;
-}
-
 template <class F>
 auto in_arena(int threads, F&& f) {
   tbb::task_arena arena(threads);
@@ -600,7 +592,7 @@ int main(int argc, char** argv) {
         a == "--frames-sweep" || a == "--registration") {
       c.mode = a.substr(2);
     } else if (a == "--scenarios" && value) {
-      c.scenarios = split(argv[++i]);
+      c.scenarios = ulc_bench::split_list(argv[++i]);
     } else if (a == "--starts" && value) {
       c.starts = std::max<std::size_t>(1, std::strtoul(argv[++i], nullptr, 10));
     } else if (a == "--frames" && value) {

@@ -447,15 +447,6 @@ int run_accuracy(const ulc_bench::Options& options, const AccuracyOptions& acc) 
   return 0;
 }
 
-std::vector<std::string> split(const std::string& s) {
-  std::vector<std::string> out;
-  std::string item;
-  std::istringstream in(s);
-  while (std::getline(in, item, ','))
-    if (!item.empty()) out.push_back(item);
-  return out;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -469,7 +460,7 @@ int main(int argc, char** argv) {
     if (a == "--accuracy") {
       accuracy = true;
     } else if (a == "--pairs" && has_value) {
-      acc.pairs = split(argv[++i]);
+      acc.pairs = ulc_bench::split_list(argv[++i]);
     } else if (a == "--samples" && has_value) {
       acc.samples = std::max<std::size_t>(1, std::strtoul(argv[++i], nullptr, 10));
     } else if (a == "--seed" && has_value) {

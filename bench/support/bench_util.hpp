@@ -202,4 +202,14 @@ class Table {
   std::vector<std::vector<Cell>> rows_;
 };
 
+/// "a,b,,c" -> {"a", "b", "c"}: the comma-separated lists of the benchmarks' options.
+inline std::vector<std::string> split_list(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream in(s);
+  std::string item;
+  while (std::getline(in, item, ','))
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
 }  // namespace ulc_bench

@@ -2,6 +2,8 @@
 // tests stay fast), the paper's disturbance of a ground truth, and exact bit comparison.
 #pragma once
 
+#include <cstdint>
+
 #include <Eigen/Core>
 #include <cmath>
 #include <cstring>
@@ -16,28 +18,25 @@ namespace calibrate_test {
 
 constexpr double kDeg = 3.14159265358979323846 / 180.0;
 
+/// A seeded 64-32 town drive, every `decimation`-th point kept.
+inline ulc::sim::Dataset simulate_64_32(double seconds, std::uint64_t seed, unsigned decimation) {
+  ulc::sim::SimulationOptions o;
+  o.seconds = seconds;
+  o.seed = seed;
+  o.decimation = decimation;
+  return ulc::sim::simulate(*ulc::sim::scenario("64-32"), o).dataset;
+}
+
 /// Six frames of each LiDAR of the 64-32 rig, the first 0.6 s of the town drive.
 inline const ulc::sim::Dataset& drive_64_32() {
-  static const ulc::sim::Dataset d = [] {
-    ulc::sim::SimulationOptions o;
-    o.seconds = 0.6;
-    o.seed = 1;
-    o.decimation = 2;
-    return ulc::sim::simulate(*ulc::sim::scenario("64-32"), o).dataset;
-  }();
+  static const ulc::sim::Dataset d = simulate_64_32(0.6, 1, 2);
   return d;
 }
 
 /// Three seconds (30 frames of each LiDAR) of the same drive, decimated 4x: enough windows for
 /// HOTS's hierarchy while the test stays short.
 inline const ulc::sim::Dataset& drive_64_32_hots() {
-  static const ulc::sim::Dataset d = [] {
-    ulc::sim::SimulationOptions o;
-    o.seconds = 3.0;
-    o.seed = 3;
-    o.decimation = 4;
-    return ulc::sim::simulate(*ulc::sim::scenario("64-32"), o).dataset;
-  }();
+  static const ulc::sim::Dataset d = simulate_64_32(3.0, 3, 4);
   return d;
 }
 

@@ -381,6 +381,20 @@ std::vector<Vec3<traits::scalar_t<SourceCloud>>> finite_points(const SourceCloud
   return points;
 }
 
+/// One source cloud as a single term: the common body of both register_point_to_plane
+/// overloads (`how` is one RegistrationOptions or a list of stages).
+template <typename S, class SourceCloud, class Target, class How>
+RegistrationResult<S> register_one_source(const SourceCloud& source, const Target& target,
+                                          const Isometry3<S>& initial, const How& how) {
+  using SourceScalar = traits::scalar_t<SourceCloud>;
+  const auto points = finite_points(source);
+  std::vector<PointToPlaneTerm<SourceScalar, Target>> terms(1);
+  terms[0].points = points.data();
+  terms[0].size = points.size();
+  terms[0].target = &target;
+  return cast_result<S>(register_point_to_plane_terms(terms, initial.template cast<double>(), how));
+}
+
 }  // namespace detail
 
 /// Registers `source` to `target` in stages (see above): the T_target_source that puts the
@@ -389,14 +403,7 @@ template <typename S, class SourceCloud, class Target>
 RegistrationResult<S> register_point_to_plane(const SourceCloud& source, const Target& target,
                                               const Isometry3<S>& initial,
                                               const std::vector<RegistrationOptions>& stages) {
-  using SourceScalar = traits::scalar_t<SourceCloud>;
-  const auto points = detail::finite_points(source);
-  std::vector<PointToPlaneTerm<SourceScalar, Target>> terms(1);
-  terms[0].points = points.data();
-  terms[0].size = points.size();
-  terms[0].target = &target;
-  return detail::cast_result<S>(
-      register_point_to_plane_terms(terms, initial.template cast<double>(), stages));
+  return detail::register_one_source(source, target, initial, stages);
 }
 
 /// Registers `source` to `target`: the T_target_source that puts the source's points on the
@@ -405,14 +412,7 @@ template <typename S, class SourceCloud, class Target>
 RegistrationResult<S> register_point_to_plane(const SourceCloud& source, const Target& target,
                                               const Isometry3<S>& initial,
                                               const RegistrationOptions& options = {}) {
-  using SourceScalar = traits::scalar_t<SourceCloud>;
-  const auto points = detail::finite_points(source);
-  std::vector<PointToPlaneTerm<SourceScalar, Target>> terms(1);
-  terms[0].points = points.data();
-  terms[0].size = points.size();
-  terms[0].target = &target;
-  return detail::cast_result<S>(
-      register_point_to_plane_terms(terms, initial.template cast<double>(), options));
+  return detail::register_one_source(source, target, initial, options);
 }
 
 }  // namespace ulc
