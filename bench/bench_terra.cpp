@@ -7,6 +7,9 @@
 //                             [--lattice 10000] [--[no-]adaptive-d1] [--min-overlap 0.2]
 //                             [--top-k 10] [--coarse-stride 10] [--d1 20] [--d2 5]
 //                             [--alpha 2] [--threads 2] [--json]
+//   ./build/bench/bench_terra --maps [--pairs 64-tele,...] [--starts 8] [--spacing 3]
+//                             [--window 2] [--decimation 1] [--below-mask 100] [--seed 1]
+//                             [--threads 2] [--json]
 //
 // Speed mode scenes: the synthetic crossroads of the tests (a 100k-point frame of an 80-beam
 // LiDAR, and a 32-beam target turned and 0.5 m away), and a simulated 64-32 frame pair
@@ -16,6 +19,11 @@
 // Accuracy mode: for each pair scenario, --samples frame pairs spread along a simulated drive;
 // the target frame is turned by a rotation uniform on SO(3) (seeded, terra::profile_case), so
 // no method can lean on the mount being near the identity. Success: e_rot < 10 deg.
+//
+// Maps mode: for each pair scenario, --starts windows of --window seconds spread along a drive,
+// the target's frames turned by a uniform random rotation per window; ulc::calibrate_pair
+// (terra stage alone) with terra_source frames, maps and automatic on the same windows.
+// Success: e_rot < 5 deg (also < 10 deg); a failed search counts as 180 deg.
 #include <tbb/task_arena.h>
 #include <Eigen/Core>
 #include <algorithm>
@@ -33,6 +41,7 @@
 #include "../tests/terra/terra_test_util.hpp"
 #include "support/bench_util.hpp"
 #include "terra/terra.hpp"
+#include "ulc/calibrate.hpp"
 #include "ulc/core/pose_error.hpp"
 #include "ulc/sim/sim.hpp"
 
@@ -447,20 +456,232 @@ int run_accuracy(const ulc_bench::Options& options, const AccuracyOptions& acc) 
   return 0;
 }
 
+// ---------------------------------------------------------------------------------------------
+// --maps: TERRA on frames vs on local maps (ulc/calibrate/map_terra.hpp) vs the automatic choice,
+// each through ulc::calibrate_pair with the terra stage alone.
+
+struct MapsOptions {
+  std::vector<std::string> pairs = {"64-tele",  "horizon-tele", "16-tele",
+                                    "32-mid40", "pitched-90",   "64-32"};
+  std::size_t starts = 8;  ///< start frames along the drive
+  double spacing_s = 3.0;  ///< between starts
+  double window_s = ulc::MapTerraOptions().window_s;
+  std::uint64_t seed = 1;
+  unsigned decimation = 1;
+  int threads = 2;
+  std::size_t below_mask = ulc::CalibrateOptions().terra_maps_below_mask;
+};
+
+/// One start: the window's frames of each LiDAR from the start on (target turned by Q).
+struct Window {
+  std::vector<ulc::PointCloud<float>> base, target;
+  std::vector<double> base_times, target_times;
+  ulc::Mat3d truth = ulc::Mat3d::Identity();  ///< R_base_target of the turned target
+};
+
+/// `starts` windows of `window_s` seconds, `spacing_s` apart along a simulated drive of the
+/// scenario's first pair; each window's target turned by a rotation uniform on SO(3) (seeded).
+std::vector<Window> simulated_windows(const std::string& name, const MapsOptions& mo,
+                                      std::string& error) {
+  std::vector<Window> out;
+  auto spec = ulc::sim::scenario(name);
+  if (!spec || spec->pairs.empty()) {
+    error = "unknown scenario '" + name + "'";
+    return out;
+  }
+  const ulc::sim::LidarPair lp = spec->pairs.front();
+  std::size_t bi = 0, ti = 0;
+  for (std::size_t i = 0; i < spec->lidars.size(); ++i) {
+    if (spec->lidars[i].name == lp.base) bi = i;
+    if (spec->lidars[i].name == lp.target) ti = i;
+  }
+  ulc::sim::SimulationOptions so;
+  so.seed = mo.seed;
+  so.decimation = mo.decimation;
+  so.keep_frames = false;
+  const double first_s = 1.0;  // skip the first second (the drive starts from rest)
+  so.seconds = first_s + mo.spacing_s * double(mo.starts) + mo.window_s + 0.5;
+  // Keep only frames inside some window (by their own timestamps; clocks agree but for the
+  // pair's offset, handled below by pairing the target start in time).
+  auto in_window = [&](double t) {
+    for (std::size_t s = 0; s < mo.starts; ++s) {
+      const double t0 = first_s + mo.spacing_s * double(s);
+      if (t >= t0 - 0.2 && t <= t0 + mo.window_s + 0.2) return true;
+    }
+    return false;
+  };
+  std::map<std::size_t, ulc::PointCloud<float>> base_frames, target_frames;
+  const auto sink = [&](const ulc::sim::FrameEvent& e) {
+    if (e.lidar == bi && in_window(e.timestamp)) base_frames[e.frame] = e.cloud;
+    if (e.lidar == ti && in_window(e.timestamp)) target_frames[e.frame] = e.cloud;
+    return true;
+  };
+  const auto result = ulc::sim::simulate(*spec, so, sink);
+  if (!result.ok()) {
+    error = name + ": " + result.reason;
+    return out;
+  }
+  const auto& ds = result.dataset;
+  const ulc::sim::PairTruth* truth = nullptr;
+  for (const auto& p : ds.pairs)
+    if (p.base == lp.base && p.target == lp.target) truth = &p;
+  if (!truth) {
+    error = name + ": no ground truth for its pair";
+    return out;
+  }
+  const auto& bt = ds.lidars[bi].timestamps;
+  const auto& tt = ds.lidars[ti].timestamps;
+  for (std::size_t s = 0; s < mo.starts; ++s) {
+    const double t0 = first_s + mo.spacing_s * double(s);
+    // Base start: first frame at or after t0; target start: nearest to it in time.
+    std::size_t kb = 0;
+    while (kb < bt.size() && bt[kb] < t0) ++kb;
+    if (kb == bt.size()) break;
+    std::size_t kt = 0;
+    double best = 1e9;
+    for (std::size_t j = 0; j < tt.size(); ++j) {
+      const double dt = std::fabs(tt[j] + truth->time_offset_s - bt[kb]);
+      if (dt < best) best = dt, kt = j;
+    }
+    terra::SplitMix64 rng(mo.seed * 1000003u + s);
+    const ulc::Mat3d Q = terra::random_rotation(rng);
+    const ulc::Mat3<float> Qf = Q.cast<float>();
+    Window w;
+    w.truth = truth->T_base_target.linear() * Q.transpose();
+    for (std::size_t k = kb; k < bt.size() && bt[k] <= bt[kb] + mo.window_s + 1e-6; ++k) {
+      const auto it = base_frames.find(k);
+      if (it == base_frames.end()) break;
+      w.base.push_back(it->second);
+      w.base_times.push_back(bt[k]);
+    }
+    for (std::size_t k = kt; k < tt.size() && tt[k] <= tt[kt] + mo.window_s + 1e-6; ++k) {
+      const auto it = target_frames.find(k);
+      if (it == target_frames.end()) break;
+      ulc::PointCloud<float> turned = it->second;
+      for (auto& p : turned.points) p = Qf * p;
+      w.target.push_back(std::move(turned));
+      w.target_times.push_back(tt[k]);
+    }
+    if (w.base.empty() || w.target.empty()) continue;
+    out.push_back(std::move(w));
+  }
+  if (out.size() < mo.starts) error = name + ": only " + std::to_string(out.size()) + " windows";
+  return out;
+}
+
+int run_maps(const ulc_bench::Options& options, const MapsOptions& mo) {
+  ulc_bench::Table table({"pair", "source", "starts", "success_5deg_pct", "success_10deg_pct",
+                          "median_deg", "median_mask", "mean_s", "note"});
+  const std::vector<std::pair<const char*, ulc::TerraSource>> sources = {
+      {"frames", ulc::TerraSource::frames},
+      {"maps", ulc::TerraSource::maps},
+      {"automatic", ulc::TerraSource::automatic}};
+  for (const std::string& name : mo.pairs) {
+    std::string error;
+    const auto windows = simulated_windows(name, mo, error);
+    if (windows.empty()) {
+      table.add_row({name, "", "0", "", "", "", "", "", error});
+      continue;
+    }
+    for (const auto& [label, source] : sources) {
+      std::vector<double> errors, masks;
+      double seconds = 0;
+      std::size_t ok5 = 0, ok10 = 0, chose_maps = 0;
+      for (std::size_t k = 0; k < windows.size(); ++k) {
+        const Window& w = windows[k];
+        ulc::CalibrateOptions co;
+        co.stages = {ulc::Stage::terra};
+        co.terra_source = source;
+        co.terra_maps.window_s = mo.window_s;
+        co.terra_maps_below_mask = mo.below_mask;
+        const auto r = in_arena(mo.threads, [&] {
+          return ulc::calibrate_pair(w.base, w.base_times, w.target, w.target_times, co);
+        });
+        const double e =
+            r.terra ? ulc::rotation_error_rad(w.truth, r.terra->rotation) / kDeg : 180.0;
+        const double err = r.success ? e : 180.0;
+        errors.push_back(err);
+        masks.push_back(r.terra ? double(r.terra->mask_count) : 0.0);
+        ok5 += err < 5.0;
+        ok10 += err < ulc::kRotationInitMaxRotationDeg;
+        seconds += r.timing_s.terra;
+        const bool maps = r.terra && r.terra->source == "maps";
+        chose_maps += maps;
+        if (!options.json)
+          std::cerr << name << " start " << k << " " << label << ": e_rot " << fmt(err, 2)
+                    << " deg, mask " << (r.terra ? r.terra->mask_count : 0) << ", frames mask "
+                    << (r.terra && r.terra->frames_mask_count
+                            ? std::to_string(*r.terra->frames_mask_count)
+                            : std::string("-"))
+                    << ", source " << (r.terra ? r.terra->source : std::string("-")) << ", map pts "
+                    << (r.terra && r.terra->base_map ? r.terra->base_map->points : 0) << "/"
+                    << (r.terra && r.terra->target_map ? r.terra->target_map->points : 0)
+                    << ", odo "
+                    << (r.terra && r.terra->target_map ? r.terra->base_map->odometry_status + "/" +
+                                                             r.terra->target_map->odometry_status
+                                                       : std::string("-"))
+                    << ", " << fmt(r.timing_s.terra, 2) << " s\n";
+      }
+      const double n = double(windows.size());
+      std::string note = error;
+      if (source == ulc::TerraSource::automatic)
+        note = "maps chosen " + std::to_string(chose_maps) + "/" + std::to_string(windows.size()) +
+               (error.empty() ? "" : "; " + error);
+      table.add_row({name, label, Cell::integer(long(windows.size())),
+                     Cell::num(100.0 * double(ok5) / n, 1), Cell::num(100.0 * double(ok10) / n, 1),
+                     Cell::num(median(errors), 2), Cell::num(median(masks), 0),
+                     Cell::num(seconds / n, 2), note});
+    }
+  }
+  const ulc_bench::Machine m = ulc_bench::machine();
+  if (options.json) {
+    table.write_json(std::cout, "bench_terra_maps", m, 1,
+                     {{"seed", Cell::integer(long(mo.seed))},
+                      {"starts", Cell::integer(long(mo.starts))},
+                      {"spacing_s", Cell::num(mo.spacing_s, 2)},
+                      {"window_s", Cell::num(mo.window_s, 2)},
+                      {"decimation", Cell::integer(long(mo.decimation))},
+                      {"below_mask", Cell::integer(long(mo.below_mask))},
+                      {"threads", Cell::integer(mo.threads)},
+                      {"success", "e_rot < 5 deg (and < 10 deg)"}});
+  } else {
+    std::cout << "bench_terra --maps: " << mo.starts << " starts " << mo.spacing_s
+              << " s apart, window " << mo.window_s << " s, target turned by a uniform random "
+              << "rotation per start; a failed search counts as 180 deg\n\n";
+    table.print(std::cout);
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   // Our own options first; the rest go to the shared parser.
-  bool accuracy = false;
+  bool accuracy = false, maps = false;
   AccuracyOptions acc;
+  MapsOptions mo;
+  bool pairs_given = false;
   std::vector<char*> rest = {argv[0]};
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     const bool has_value = i + 1 < argc;
     if (a == "--accuracy") {
       accuracy = true;
+    } else if (a == "--maps") {
+      maps = true;
+    } else if (a == "--starts" && has_value) {
+      mo.starts = std::max<std::size_t>(1, std::strtoul(argv[++i], nullptr, 10));
+    } else if (a == "--spacing" && has_value) {
+      mo.spacing_s = std::atof(argv[++i]);
+    } else if (a == "--window" && has_value) {
+      mo.window_s = std::atof(argv[++i]);
+    } else if (a == "--decimation" && has_value) {
+      mo.decimation = unsigned(std::max(1, std::atoi(argv[++i])));
+    } else if (a == "--below-mask" && has_value) {
+      mo.below_mask = std::strtoul(argv[++i], nullptr, 10);
     } else if (a == "--pairs" && has_value) {
       acc.pairs = ulc_bench::split_list(argv[++i]);
+      pairs_given = true;
     } else if (a == "--samples" && has_value) {
       acc.samples = std::max<std::size_t>(1, std::strtoul(argv[++i], nullptr, 10));
     } else if (a == "--seed" && has_value) {
@@ -493,6 +714,13 @@ int main(int argc, char** argv) {
       static_cast<int>(rest.size()), rest.data(),
       "TERRA speed (default) or accuracy against scancontext* (--accuracy [--pairs a,b] "
       "[--samples 50] [--seed 1] [--lattice 10000] [--[no-]adaptive-d1] [--min-overlap 0.2] "
-      "[--threads 2])");
+      "[--threads 2]) or frames vs local maps (--maps [--pairs ...] [--starts 8] [--spacing 3] "
+      "[--window 2] [--decimation 1] [--below-mask 100] [--seed 1] [--threads 2])");
+  if (maps) {
+    if (pairs_given) mo.pairs = acc.pairs;
+    mo.seed = acc.seed;
+    mo.threads = acc.threads;
+    return run_maps(options, mo);
+  }
   return accuracy ? run_accuracy(options, acc) : run_speed(options);
 }

@@ -1,5 +1,7 @@
 // `ulc calibrate`: the extrinsic of every target LiDAR against the base, through the stages asked
 // for (terra, jeep, hots), written as the result file of DESIGN.md and summarised on stdout.
+// The targets form a rig (ulc/calibrate/rig.hpp): a target that fails against the base is routed
+// through one that succeeded, and with two targets or more the cycles between them are closed.
 #include <tbb/task_arena.h>
 
 #include <cstdio>
@@ -18,6 +20,7 @@
 #include "progress.hpp"
 #include "ulc/calibrate.hpp"
 #include "ulc/calibrate/result_entry.hpp"
+#include "ulc/calibrate/rig.hpp"
 #include "ulc/io/result_file.hpp"
 #include "ulc/io/result_yaml.hpp"
 #include "ulc/io/sequence.hpp"
@@ -27,20 +30,20 @@ namespace {
 
 constexpr double kDeg = 180.0 / 3.14159265358979323846;
 
-/// One bar (or plain lines) per stage of one target, labelled "<target> <stage>".
+/// One bar (or plain lines) per stage of one calibration, labelled as the rig labels it:
+/// "<target> <stage>", "<target> via <lidar> <stage>" or "cycle <i>-<j> <stage>".
 class StageProgress {
  public:
-  StageProgress(std::string target, bool quiet) : target_(std::move(target)), quiet_(quiet) {}
+  explicit StageProgress(bool quiet) : quiet_(quiet) {}
   void operator()(const std::string& stage, double fraction) {
     if (!bar_ || stage != stage_) {
       stage_ = stage;
-      bar_ = std::make_unique<Progress>(target_ + " " + stage, quiet_);
+      bar_ = std::make_unique<Progress>(stage, quiet_);
     }
     bar_->update(static_cast<std::size_t>(fraction * 100.0 + 0.5), 100);
   }
 
  private:
-  std::string target_;
   bool quiet_;
   std::string stage_;
   std::unique_ptr<Progress> bar_;
@@ -68,9 +71,45 @@ std::vector<Eigen::Vector3f> points_of(const PointCloud<float>& cloud) {
   return std::vector<Eigen::Vector3f>(cloud.points.begin(), cloud.points.end());
 }
 
+/// The stages of the cycle checks: the pair stages without HOTS (TERRA + JEEP is the cheap,
+/// independent check); HOTS alone leaves JEEP, started from the chained extrinsics.
+std::vector<Stage> cycle_stages(const std::vector<Stage>& stages) {
+  std::vector<Stage> out;
+  for (const Stage s : stages)
+    if (s != Stage::hots) out.push_back(s);
+  if (out.empty()) out.push_back(Stage::jeep);
+  return out;
+}
+
+/// The result-file entry of one target of the rig: its calibration, and for a routed target
+/// the LiDAR it went through and why the direct attempt failed.
+io::PairResult rig_entry(const RigTarget& t, const std::string& base, std::size_t frame_index) {
+  io::PairResult r = to_pair_result(t.result, base, t.name);
+  if (r.stages.find("terra")) r.stages["terra"]["frame_index"] = frame_index;
+  if (t.routed()) {
+    r.via = t.via_name;
+    r.direct_status = to_string(t.direct.status);
+    r.direct_reason = t.direct.reason;
+  }
+  return r;
+}
+
+io::CycleResult cycle_entry(const RigCycle& c, const std::string& base) {
+  io::CycleResult r;
+  r.lidars = {base, c.name_i, c.name_j};
+  r.status = to_string(c.pair.status);
+  r.reason = c.pair.reason;
+  r.rotation_deg = c.rotation_deg;
+  r.translation_m = c.translation_m;
+  return r;
+}
+
 void print_summary(const io::PairResult& r) {
   std::printf("%s <- %s: %s%s%s\n", r.base.c_str(), r.target.c_str(), r.status.c_str(),
               r.reason.empty() ? "" : ": ", r.reason.c_str());
+  if (!r.via.empty())
+    std::printf("  route   %s <- %s <- %s (direct: %s)\n", r.base.c_str(), r.via.c_str(),
+                r.target.c_str(), r.direct_status.c_str());
   const Eigen::Vector3d t = r.T_base_target.translation();
   const Eigen::Vector3d rpy = ulc::rpy_from_rotation(r.T_base_target.linear()) * kDeg;
   std::printf("  xyz_m   %9.4f %9.4f %9.4f\n", t.x(), t.y(), t.z());
@@ -82,6 +121,17 @@ void print_summary(const io::PairResult& r) {
               r.timing_s.at("terra").as_number(), r.timing_s.at("jeep").as_number(),
               r.timing_s.at("odometry").as_number(), r.timing_s.at("hots").as_number(),
               r.timing_s.at("total").as_number());
+}
+
+void print_cycle(const io::CycleResult& c) {
+  const std::string& base = c.lidars.at(0);
+  std::printf("cycle %s -> %s -> %s -> %s: ", base.c_str(), c.lidars.at(1).c_str(),
+              c.lidars.at(2).c_str(), base.c_str());
+  if (c.rotation_deg && c.translation_m)
+    std::printf("closure %.3f deg %.2f cm\n", *c.rotation_deg, *c.translation_m * 100.0);
+  else
+    std::printf("not closed: %s -> %s %s: %s\n", c.lidars.at(1).c_str(), c.lidars.at(2).c_str(),
+                c.status.c_str(), c.reason.c_str());
 }
 
 }  // namespace
@@ -103,6 +153,9 @@ int run_calibrate(int argc, char** argv) {
       .option("frame-index", "N", "TERRA's frame, and the first frame of JEEP and HOTS (default 0)")
       .option("frames", "K", "frame pairs JEEP uses (default 5)")
       .option("threads", "N", "worker threads (default: all cores)")
+      .flag("no-route",
+            "do not calibrate a failed target through another target that did calibrate")
+      .flag("no-cycles", "do not check the cycles base -> i -> j -> base (two targets or more)")
       .flag("quiet", "no progress on stderr")
       .flag("help", "show this help");
   args.parse(argc, argv, 1);
@@ -111,8 +164,13 @@ int run_calibrate(int argc, char** argv) {
                 args.help_text("Finds the extrinsic T_base_target of each target LiDAR "
                                "against the base, with no initial guess (TERRA), "
                                "refined (JEEP), then over every frame with the clock "
-                               "offset (odometry + HOTS). Exit 0: all calibrated; 1: some did not "
-                               "(the result file says why); 2: bad usage or input.")
+                               "offset (odometry + HOTS). A target that fails against the base is "
+                               "calibrated through another target that succeeded (\"via\" in "
+                               "the result file); with two targets or more, each pair of "
+                               "targets is calibrated (terra,jeep) to report how far the cycle "
+                               "base -> i -> j -> base fails to close. Exit 0: every target "
+                               "calibrated, directly or through another; 1: some did not (the "
+                               "result file says why); 2: bad usage or input.")
                     .c_str());
     return kExitOk;
   }
@@ -149,6 +207,14 @@ int run_calibrate(int argc, char** argv) {
   for (const auto& path : args.get_all("target")) targets.emplace_back(path);
   require_frame(base, frame_index);
   for (const auto& t : targets) require_frame(t, frame_index);
+  for (std::size_t k = 0; k < targets.size(); ++k) {  // the result file keys on the names
+    const std::string& name = targets[k].name();
+    bool repeated = name == base.name();
+    for (std::size_t m = 0; m < k; ++m) repeated = repeated || targets[m].name() == name;
+    if (repeated)
+      throw cli::UsageError("calibrate: two LiDARs are named '" + name + "' (" +
+                            targets[k].path().string() + "); give each its own folder name");
+  }
 
   // The frames each stage needs, counted from frame_index; the base's are shared by all targets.
   // HOTS needs them all.
@@ -158,45 +224,63 @@ int run_calibrate(int argc, char** argv) {
   const bool quiet = args.has("quiet");
   const LoadedFrames base_frames = load_frames(base, frame_index, base_count);
 
-  std::vector<io::PairResult> results;
-  std::vector<FusedPart> fused{{points_of(base_frames.clouds.front()), Isometry3d::Identity()}};
-  std::vector<ReportCloud> report{
-      {base.name(), fused.front().points, Isometry3d::Identity(), Isometry3d::Identity()}};
+  // Every LiDAR's frames are held for the whole rig: routes and cycles pair targets too.
+  std::vector<LoadedFrames> target_frames;
   for (const auto& target : targets) {
     const std::size_t count = run_hots   ? target.size() - frame_index
                               : run_jeep ? covering_count(base, target, base_count)
                                          : 1;
-    const LoadedFrames target_frames = load_frames(target, frame_index, count);
-    CalibrateOptions pair_options = options;
-    pair_options.frame_index = 0;  // the loaded frames start at frame_index
-    if (!run_terra)
-      pair_options.initial = parse_initial(args.get("initial"), base.name(), target.name());
-    StageProgress progress(target.name(), quiet);
-    pair_options.progress = [&progress](const std::string& stage, double f) { progress(stage, f); };
-    auto run = [&] {
-      return calibrate_pair(base_frames.clouds, base_frames.times, target_frames.clouds,
-                            target_frames.times, pair_options);
-    };
-    const PairCalibration c = arena ? arena->execute(run) : run();
-    io::PairResult r = to_pair_result(c, base.name(), target.name());
-    if (r.stages.find("terra")) r.stages["terra"]["frame_index"] = frame_index;
+    target_frames.push_back(load_frames(target, frame_index, count));
+  }
+  using Frames = std::vector<PointCloud<float>>;
+  std::vector<RigLidar<Frames>> lidars{{base.name(), &base_frames.clouds, &base_frames.times, {}}};
+  for (std::size_t k = 0; k < targets.size(); ++k) {
+    RigLidar<Frames> l{targets[k].name(), &target_frames[k].clouds, &target_frames[k].times, {}};
+    if (!run_terra) l.initial = parse_initial(args.get("initial"), base.name(), l.name);
+    lidars.push_back(std::move(l));
+  }
+  RigOptions rig_options;
+  rig_options.pair = options;
+  rig_options.pair.frame_index = 0;  // the loaded frames start at frame_index
+  rig_options.route = !args.has("no-route");
+  rig_options.cycles = !args.has("no-cycles") && targets.size() >= 2;
+  rig_options.cycle_stages = cycle_stages(options.stages);
+  StageProgress progress(quiet);
+  rig_options.pair.progress = [&progress](const std::string& stage, double f) {
+    progress(stage, f);
+  };
+  auto run = [&] { return calibrate_rig(lidars, 0, rig_options); };
+  const RigCalibration rig = arena ? arena->execute(run) : run();
+  if (rig.status == RigStatus::invalid_input) throw cli::UsageError("calibrate: " + rig.reason);
+
+  std::vector<io::PairResult> results;
+  std::vector<FusedPart> fused{{points_of(base_frames.clouds.front()), Isometry3d::Identity()}};
+  std::vector<ReportCloud> report{
+      {base.name(), fused.front().points, Isometry3d::Identity(), Isometry3d::Identity()}};
+  for (std::size_t k = 0; k < rig.targets.size(); ++k) {
+    const RigTarget& t = rig.targets[k];
+    results.push_back(rig_entry(t, base.name(), frame_index));
+    print_summary(results.back());
     if (args.has("merged-cloud") || args.has("report")) {
       // Pictures show the calibrated frames only when they are worth showing; a failed target is
       // drawn where its guess put it, in both panels.
-      const Isometry3d before = pair_options.initial.value_or(Isometry3d::Identity());
-      const Isometry3d after = r.success ? r.T_base_target : before;
-      fused.push_back({points_of(target_frames.clouds.front()), after});
-      report.push_back({target.name(), fused.back().points, before, after});
+      const Isometry3d before = lidars[t.lidar].initial.value_or(Isometry3d::Identity());
+      const Isometry3d after = t.ok() ? t.result.T_base_target : before;
+      fused.push_back({points_of(target_frames[k].clouds.front()), after});
+      report.push_back({t.name, fused.back().points, before, after});
     }
-    results.push_back(std::move(r));
-    print_summary(results.back());
+  }
+  std::vector<io::CycleResult> cycles;
+  for (const RigCycle& c : rig.cycles) {
+    cycles.push_back(cycle_entry(c, base.name()));
+    print_cycle(cycles.back());
   }
 
   if (args.has("output")) {
     if (format == "yaml")
-      io::write_result_yaml(args.get("output"), results);
+      io::write_result_yaml(args.get("output"), results, cycles);
     else
-      io::write_result_file(args.get("output"), results);
+      io::write_result_file(args.get("output"), results, cycles);
     std::printf("wrote %s\n", args.get("output").c_str());
   }
   if (args.has("merged-cloud")) {

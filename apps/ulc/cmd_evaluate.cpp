@@ -1,7 +1,10 @@
 // `ulc evaluate`: a result file against a dataset's ground truth, with the paper's metrics.
+// A rig's result file also carries routes ("via") and cycle closures: they are shown as written
+// (a closure needs no ground truth) and do not change the exit code.
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <vector>
 
 #include "cli_args.hpp"
 #include "commands.hpp"
@@ -61,7 +64,8 @@ int run_evaluate(int argc, char** argv) {
                           .c_str());
     return kExitOk;
   }
-  const auto results = io::read_result_file(args.get("result"));
+  const io::ResultDocument file = io::read_result_document(args.get("result"));
+  const std::vector<io::PairResult>& results = file.results;
   const auto gt = io::read_ground_truth(args.get("ground-truth"));
 
   io::Json pairs = io::Json::array();
@@ -79,11 +83,15 @@ int run_evaluate(int argc, char** argv) {
     e["time_offset_error_s"] =
         ev.time_offset_error_s ? io::Json(*ev.time_offset_error_s) : io::Json();
     e["success"] = ev.success;
+    if (!r.via.empty()) e["via"] = r.via;
     pairs.push_back(std::move(e));
   }
+  io::Json cycles = io::Json::array();
+  for (const auto& c : file.cycles) cycles.push_back(io::to_json(c));
   if (args.has("json")) {
     io::Json doc = io::Json::object();
     doc["pairs"] = std::move(pairs);
+    if (!file.cycles.empty()) doc["cycles"] = std::move(cycles);
     doc["success_criterion"] = "e_rot < 1 deg and e_trans < 0.1 m";
     std::printf("%s\n", doc.dump(1).c_str());
   } else {
@@ -96,15 +104,27 @@ int run_evaluate(int argc, char** argv) {
         std::snprintf(buf, sizeof buf, fmt, j.as_number() * scale);
         return std::string(buf);
       };
-      std::printf("%-12s %-12s %10s %10s %12s  %s\n", e.at("base").as_string().c_str(),
+      const io::Json* via = e.find("via");
+      std::printf("%-12s %-12s %10s %10s %12s  %s%s%s\n", e.at("base").as_string().c_str(),
                   e.at("target").as_string().c_str(), num(e.at("e_rot_deg"), 1, "%.4f").c_str(),
                   num(e.at("e_trans_m"), 1, "%.4f").c_str(),
                   num(e.at("time_offset_error_s"), 1000, "%.2f").c_str(),
                   !e.at("ground_truth_found").as_bool() ? "no ground truth"
                   : e.at("success").as_bool()           ? "yes"
-                                                        : "no");
+                                                        : "no",
+                  via ? " (via " : "", via ? (via->as_string() + ")").c_str() : "");
     }
     std::printf("success: e_rot < 1 deg and e_trans < 0.1 m (and the calibration said ok)\n");
+    for (const auto& c : file.cycles) {
+      std::string names;
+      for (const auto& n : c.lidars) names += n + " -> ";
+      names += c.lidars.empty() ? "" : c.lidars.front();
+      if (c.rotation_deg && c.translation_m)
+        std::printf("cycle %s: closure %.4f deg %.4f m\n", names.c_str(), *c.rotation_deg,
+                    *c.translation_m);
+      else
+        std::printf("cycle %s: not closed (%s)\n", names.c_str(), c.status.c_str());
+    }
   }
   return failures == 0 && !results.empty() ? kExitOk : kExitFailed;
 }

@@ -4,7 +4,9 @@
 //   -> deskewed, downsampled frames -> one hierarchy per LiDAR (hierarchy.hpp)
 //   -> cross-LiDAR links (cross_links.hpp) -> one pose graph with the extrinsic as a variable,
 //      solved by our sparse LM (pose_graph.hpp, sparse_lm.hpp)
-//   -> time synchronisation on the refined poses (time_sync.hpp) -> extrinsic, clock offset.
+//   -> time synchronisation on the refined poses (time_sync.hpp)
+//   -> every target frame against the base's submaps through the base's refined trajectory
+//      (sequence_extrinsic.hpp) -> extrinsic, clock offset.
 //
 // Conventions this header owns:
 //   - Inputs: frames (random-access containers of traits clouds, points in the LiDAR frame at
@@ -25,14 +27,18 @@
 //     clock offset only through the current estimate, so they are deliberately weak: the
 //     offset itself comes from the time synchronisation, and a second pass (passes = 2)
 //     rebuilds the ties with it.
-//   - Result extrinsic = the time synchronisation's mean (eq:mean); without synchronisation,
-//     the graph's C. covariance_6x6 = the spread of the per-pair extrinsics ([rho; phi], left);
-//     without synchronisation, the graph's marginal covariance of C.
+//   - Result extrinsic and offset = the whole-sequence step's (sequence_extrinsic.hpp),
+//     started from the time synchronisation's mean (eq:mean) and offset (without
+//     synchronisation: the graph's C and time_offset_s); with that step disabled, its start.
+//     statistics keep the graph's and the synchronisation's answers. covariance_6x6 = the spread of
+//     the per-pair extrinsics ([rho; phi], left); without synchronisation, the graph's marginal
+//     covariance of C.
 //   - refined poses are returned in the input map frames (b's through T_mapa_mapb).
 //   - Nothing here throws or prints; results are the same for any number of threads.
 #pragma once
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstddef>
 #include <vector>
@@ -43,6 +49,7 @@
 #include "hots/cross_links.hpp"
 #include "hots/hierarchy.hpp"
 #include "hots/pose_graph.hpp"
+#include "hots/sequence_extrinsic.hpp"
 #include "hots/sparse_lm.hpp"
 #include "hots/time_sync.hpp"
 #include "ulc/core/deskew.hpp"
@@ -63,9 +70,12 @@ struct RefineOptions {
   bool synchronise_time = true;
   TimeSyncOptions time_sync;  ///< centre_s is replaced by time_offset_s
   int passes = 2;
+  /// The last step: C and dt from every target frame against the base's submaps
+  /// (sequence_extrinsic.hpp), started from the time synchronisation's answer.
+  SequenceExtrinsicOptions sequence;
 };
 
-enum class RefineStatus { ok, invalid_input, graph_failed, time_sync_failed };
+enum class RefineStatus { ok, invalid_input, graph_failed, time_sync_failed, sequence_failed };
 
 inline const char* to_string(RefineStatus s) {
   switch (s) {
@@ -75,6 +85,8 @@ inline const char* to_string(RefineStatus s) {
       return "invalid_input";
     case RefineStatus::graph_failed:
       return "graph_failed";
+    case RefineStatus::sequence_failed:
+      return "sequence_failed";
     default:
       return "time_sync_failed";
   }
@@ -88,6 +100,11 @@ struct RefineStatistics {
   double time_sync_spread = 0.0;
   std::size_t time_sync_pairs = 0;
   Isometry3d graph_extrinsic = Isometry3d::Identity();  ///< C as the pose graph left it
+  Isometry3d sync_extrinsic = Isometry3d::Identity();   ///< C of the time synchronisation
+  double sync_time_offset_s = 0.0;                      ///< dt of the time synchronisation
+  bool sync_significant = false;                        ///< its minimum passed the test
+  SequenceExtrinsicResult sequence;                     ///< the last step (status disabled: off)
+  double sequence_seconds = 0.0;                        ///< its wall time (statistics only)
 };
 
 struct RefineResult {
@@ -287,7 +304,27 @@ RefineResult refine(const FramesA& frames_a, const std::vector<double>& times_a,
     result.spread_curve = sync.curve;
     st.time_sync_spread = sync.spread;
     st.time_sync_pairs = sync.pairs;
+    st.sync_extrinsic = sync.extrinsic;
+    st.sync_time_offset_s = sync.time_offset_s;
+    st.sync_significant = sync.significant;
     graph.variables[c_var] = sync.extrinsic;
+  }
+
+  if (options.sequence.enabled) {
+    const std::vector<Isometry3d> wa(graph.variables.begin(),
+                                     graph.variables.begin() + static_cast<std::ptrdiff_t>(na));
+    // The joint dt is refined only where the synchronisation found an offset at all: its
+    // significance test is what keeps a synchronised rig at exactly zero.
+    SequenceExtrinsicOptions so = options.sequence;
+    so.estimate_time_offset = so.estimate_time_offset && st.sync_significant;
+    const auto t0 = std::chrono::steady_clock::now();
+    st.sequence = sequence_extrinsic(ha, fa, times_a, wa, fb, times_b, result.extrinsic,
+                                     result.time_offset_s, so);
+    st.sequence_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (!st.sequence.ok()) return fail(RefineStatus::sequence_failed, st.sequence.reason);
+    result.extrinsic = st.sequence.extrinsic;
+    result.time_offset_s = st.sequence.time_offset_s;
   }
 
   const Isometry3d mapb_mapa = mapa_mapb.inverse();

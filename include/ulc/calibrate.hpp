@@ -11,7 +11,12 @@
 //     per-point times relative to the frame timestamp) and their timestamps (seconds, each
 //     LiDAR's own clock, one per frame).
 //   - frame_index i: TERRA uses frame i of each LiDAR (the same index, so clock offsets do not
-//     matter); JEEP pairs frames by timestamp from frame i of each on and uses the first
+//     matter), or each LiDAR's local map over a window from frame i on (map_terra.hpp), as
+//     CalibrateOptions::terra_source says. automatic runs the frame search first and keeps it
+//     unless the sequences hold at least terra_maps_min_frames frames per LiDAR in the window
+//     AND the frame search failed or overlaps in fewer than terra_maps_below_mask cells; then
+//     the map search runs and wins when it succeeds with a larger mask. stages.terra says which
+//     ("source") and why. JEEP pairs frames by timestamp from frame i of each on and uses the first
 //     JeepOptions::frames pairs. Frames before i are never touched.
 //   - Stages: any ordered subset of terra, jeep, hots (stages.hpp); the default is all three
 //     (DESIGN.md). TERRA needs no prior and ignores `initial`; each later stage starts from the
@@ -44,6 +49,7 @@
 #include "jeep/run_odometry.hpp"
 #include "terra/search.hpp"
 #include "ulc/calibrate/frame_range.hpp"
+#include "ulc/calibrate/map_terra.hpp"
 #include "ulc/calibrate/pair_calibration.hpp"
 #include "ulc/calibrate/stages.hpp"
 #include "ulc/core/point_traits.hpp"
@@ -55,9 +61,36 @@ namespace ulc {
 /// done.
 using CalibrateProgress = std::function<void(const std::string& stage, double fraction)>;
 
+/// What TERRA compares: single frames (the paper's default) or each LiDAR's local map over a
+/// short window (the paper's remedy for small overlap, map_terra.hpp).
+enum class TerraSource {
+  automatic,  ///< frames first; maps when the sequences allow and the frames overlap too little
+  frames,     ///< frame frame_index of each LiDAR
+  maps        ///< local maps from frame_index on (a single frame gives a one-frame map)
+};
+
+inline const char* to_string(TerraSource s) {
+  switch (s) {
+    case TerraSource::automatic:
+      return "automatic";
+    case TerraSource::frames:
+      return "frames";
+    default:
+      return "maps";
+  }
+}
+
 /// Everything calibrate_pair can be told; the defaults are the paper's.
 struct CalibrateOptions {
-  terra::SearchParams terra;       ///< N = 10000, d1 = 20 m, d2 = 5 m, alpha = 2, 10/1 deg strides
+  terra::SearchParams terra;  ///< N = 10000, d1 = 20 m, d2 = 5 m, alpha = 2, 10/1 deg strides
+  TerraSource terra_source = TerraSource::automatic;
+  MapTerraOptions terra_maps;  ///< window, thinning and odometry of the local maps
+  /// automatic: the maps are tried only when each LiDAR has at least this many frames in the
+  /// window from frame_index (a single frame, or a static snapshot, stays on frames) ...
+  std::size_t terra_maps_min_frames = 5;
+  /// ... and the frame search failed or its eq:mask count at its answer is below this many
+  /// cells. The map result is then kept when it succeeded with a larger mask count.
+  std::size_t terra_maps_below_mask = 100;
   jeep::JeepOptions jeep;          ///< K = 5 frame pairs, at most 10 rounds
   jeep::OdometryOptions odometry;  ///< the odometry over all frames that feeds HOTS
   hots::RefineOptions hots;        ///< windows of 5, 3 layers, time synchronisation on
@@ -94,6 +127,98 @@ inline TerraReport terra_report(const terra::SearchResult& s, std::size_t frame_
   t.stats = s.stats;
   t.seconds = seconds;
   return t;
+}
+
+/// The TERRA stage's path choice (CalibrateOptions::terra_source): fills r.terra (all but
+/// seconds) and returns the kept search.
+template <class FramesA, class FramesB>
+terra::SearchResult terra_stage(const FramesA& frames_a, const std::vector<double>& times_a,
+                                const FramesB& frames_b, const std::vector<double>& times_b,
+                                const CalibrateOptions& options, PairCalibration& r) {
+  const CalibrateProgress& report = options.progress;
+  const std::size_t i = options.frame_index;
+  const terra::SearchParams& params = options.terra;
+  const terra::Lattice lattice(params.lattice_size >= 2 ? params.lattice_size : 0);
+  const std::size_t window =
+      std::min(map_terra_detail::window_frames(times_a, i, options.terra_maps),
+               map_terra_detail::window_frames(times_b, i, options.terra_maps));
+  const TerraSource source = options.terra_source;
+  const bool frames_first = source != TerraSource::maps;
+  // Progress: the frame search is fast; when maps may follow they get most of the bar.
+  const bool maps_possible =
+      source == TerraSource::maps ||
+      (source == TerraSource::automatic && window >= options.terra_maps_min_frames);
+  const double frame_share = maps_possible ? 0.2 : 1.0;
+
+  auto search_frames = [&] {
+    terra::SearchParams p = params;
+    if (report) p.progress = [&](double f) { report("terra", frame_share * f); };
+    return params.lattice_size < 2 ? terra::estimate_rotation(frames_a[i], frames_b[i], p)
+                                   : terra::estimate_rotation(lattice, frames_a[i], frames_b[i], p);
+  };
+  auto search_maps = [&] {
+    const double from = frames_first ? frame_share : 0.0;
+    std::function<void(double)> progress;
+    if (report) progress = [&](double f) { report("terra", from + (1.0 - from) * f); };
+    return params.lattice_size < 2 ? map_terra(frames_a, times_a, frames_b, times_b, i, params,
+                                               options.terra_maps, progress)
+                                   : map_terra(lattice, frames_a, times_a, frames_b, times_b, i,
+                                               params, options.terra_maps, progress);
+  };
+  auto keep_frames = [&](const terra::SearchResult& s, std::string why) {
+    r.terra = terra_report(s, i, traits::size(frames_a[i]), traits::size(frames_b[i]),
+                           params.lattice_size, 0.0);
+    r.terra->source = "frames";
+    r.terra->source_reason = std::move(why);
+    r.terra->frames_mask_count = s.mask_count;
+    r.terra->frames_status = terra::to_string(s.status);
+  };
+  auto keep_maps = [&](const MapTerraResult& m, std::string why) {
+    r.terra = terra_report(m.search, i, m.base.points, m.target.points, params.lattice_size, 0.0);
+    r.terra->source = "maps";
+    r.terra->source_reason = std::move(why);
+    r.terra->base_map = m.base;
+    r.terra->target_map = m.target;
+  };
+
+  if (source == TerraSource::maps) {
+    const MapTerraResult m = search_maps();
+    keep_maps(m, "terra_source = maps");
+    return m.search;
+  }
+  const terra::SearchResult f = search_frames();
+  if (source == TerraSource::frames) {
+    keep_frames(f, "terra_source = frames");
+    return f;
+  }
+  if (!maps_possible) {
+    keep_frames(f, "automatic: " + std::to_string(window) + " frame(s) per LiDAR in the map " +
+                       "window (maps need " + std::to_string(options.terra_maps_min_frames) + ")");
+    return f;
+  }
+  if (f.ok() && f.mask_count >= options.terra_maps_below_mask) {
+    keep_frames(f, "automatic: the frames overlap in " + std::to_string(f.mask_count) +
+                       " cells (maps are tried below " +
+                       std::to_string(options.terra_maps_below_mask) + ")");
+    return f;
+  }
+  const MapTerraResult m = search_maps();
+  const std::string frames_said =
+      f.ok() ? "the frames overlap in only " + std::to_string(f.mask_count) + " cells"
+             : std::string("the frame search failed (") + terra::to_string(f.status) + ")";
+  if (m.ok() && (!f.ok() || m.search.mask_count > f.mask_count)) {
+    keep_maps(m,
+              "automatic: " + frames_said + "; the maps in " + std::to_string(m.search.mask_count));
+    r.terra->frames_mask_count = f.mask_count;
+    r.terra->frames_status = terra::to_string(f.status);
+    return m.search;
+  }
+  keep_frames(f, "automatic: " + frames_said + ", but the map search " +
+                     (m.ok() ? "overlaps less (" + std::to_string(m.search.mask_count) + " cells)"
+                             : std::string("failed: ") + m.search.reason));
+  r.terra->base_map = m.base;
+  r.terra->target_map = m.target;
+  return f;
 }
 
 inline JeepReport jeep_report(const jeep::JeepResult& j, const Isometry3d& initial,
@@ -197,17 +322,15 @@ PairCalibration calibrate_pair(const FramesA& frames_a, const std::vector<double
 
   if (run_terra) {
     const auto t0 = std::chrono::steady_clock::now();
-    terra::SearchParams params = options.terra;
-    if (options.progress) params.progress = [&](double f) { report("terra", f); };
-    const auto& a = frames_a[i];
-    const auto& b = frames_b[i];
-    const terra::SearchResult s = terra::estimate_rotation(a, b, params);
-    r.terra = calibrate_detail::terra_report(s, i, traits::size(a), traits::size(b),
-                                             params.lattice_size, seconds_since(t0));
+    const terra::SearchResult s =
+        calibrate_detail::terra_stage(frames_a, times_a, frames_b, times_b, options, r);
+    r.terra->seconds = seconds_since(t0);
+    report("terra", 1.0);  // the map search may not have run after the frames' share
     r.timing_s.terra = r.terra->seconds;
     if (!s.ok())
-      return finish(CalibrateStatus::terra_failed,
-                    std::string("TERRA: ") + terra::to_string(s.status) + ": " + s.reason);
+      return finish(CalibrateStatus::terra_failed, std::string("TERRA: ") +
+                                                       terra::to_string(s.status) + ": " +
+                                                       s.reason + " (on " + r.terra->source + ")");
     C = Isometry3d::Identity();
     C.linear() = s.rotation;
     r.T_base_target = C;

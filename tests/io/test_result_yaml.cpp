@@ -124,6 +124,38 @@ TEST_CASE("YAML result: one entry per target, a missing time offset is null") {
   CHECK(yaml.find("success: false") != std::string::npos);
 }
 
+TEST_CASE("YAML result: a routed entry names its route, a rig's cycles follow the results") {
+  ulc::io::PairResult a = example(), b = example();
+  b.target = "right";
+  b.via = "left";
+  b.direct_status = "jeep_failed";
+  b.direct_reason = "JEEP: rejected";
+  ulc::io::CycleResult closed, open;
+  closed.lidars = {"top", "left", "right"};
+  closed.status = "ok";
+  closed.rotation_deg = 0.125;
+  closed.translation_m = 0.0075;
+  open.lidars = {"top", "left", "back"};
+  open.status = "terra_failed";
+  const std::string yaml = ulc::io::results_to_yaml({a, b}, {closed, open});
+  // The route only on the routed entry, after the results.
+  CHECK(yaml.find("via: ") == yaml.find("    via: \"left\"\n") + 4);
+  CHECK(yaml.find("via: ") > yaml.find("target: \"right\""));
+  CHECK(yaml.find("direct_status: \"jeep_failed\"") != std::string::npos);
+  CHECK(yaml.find("direct_reason: \"JEEP: rejected\"") != std::string::npos);
+  const auto cycles = yaml.find("\ncycles:\n");
+  REQUIRE(cycles != std::string::npos);
+  CHECK(cycles > yaml.find("</joint>", yaml.find("target: \"right\"")));
+  const std::string tail = yaml.substr(cycles);
+  CHECK(tail.find("  - lidars: [\"top\", \"left\", \"right\"]\n    status: \"ok\"") !=
+        std::string::npos);
+  CHECK(numbers(value_of(tail, "rotation_deg")).at(0) == 0.125);
+  CHECK(numbers(value_of(tail, "translation_m")).at(0) == 0.0075);
+  CHECK(tail.find("rotation_deg: null") > tail.find("\"back\""));
+  // Without cycles there is no cycles key (files of single pairs stay as they were).
+  CHECK(ulc::io::results_to_yaml({a}).find("cycles") == std::string::npos);
+}
+
 TEST_CASE("YAML result: an unwritable path throws an IoError naming it") {
   CHECK_THROWS_AS(ulc::io::write_result_yaml("/nonexistent_dir/x.yaml", {example()}),
                   ulc::io::IoError);

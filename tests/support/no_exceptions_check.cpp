@@ -6,6 +6,7 @@
 #include "jeep/scan_scan.hpp"
 #include "terra/terra.hpp"
 #include "ulc/calibrate.hpp"
+#include "ulc/calibrate/rig.hpp"
 #include "ulc/core/cloud.hpp"
 #include "ulc/core/kdtree.hpp"
 #include "ulc/core/lie.hpp"
@@ -30,3 +31,6 @@ template ulc::PairCalibration ulc::calibrate_pair(const std::vector<ulc::PointCl
                                                   const std::vector<ulc::PointCloud<float>>&,
                                                   const std::vector<double>&,
                                                   const ulc::CalibrateOptions&);
+template ulc::RigCalibration ulc::calibrate_rig(
+    const std::vector<ulc::RigLidar<std::vector<ulc::PointCloud<float>>>>&, std::size_t,
+    const ulc::RigOptions&);

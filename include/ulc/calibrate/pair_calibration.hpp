@@ -21,6 +21,7 @@
 
 #include "hots/hots.hpp"
 #include "terra/search_params.hpp"
+#include "ulc/calibrate/map_terra.hpp"
 #include "ulc/calibrate/stages.hpp"
 #include "ulc/core/types.hpp"
 
@@ -55,18 +56,27 @@ inline const char* to_string(CalibrateStatus s) {
   }
 }
 
-/// The TERRA stage: a rotation from one frame of each LiDAR, no prior.
+/// The TERRA stage: a rotation from one frame of each LiDAR, or from each LiDAR's local map
+/// over a short window from that frame (map_terra.hpp), no prior. The fields above `source`
+/// describe the search whose rotation was kept.
 struct TerraReport {
   std::string status;  ///< terra::to_string(SearchStatus)
   std::string reason;
   Mat3d rotation = Mat3d::Identity();  ///< R_base_target found
   double distance = 0.0;               ///< eq:feature_dis at the rotation
   std::size_t mask_count = 0;          ///< cells in eq:mask at the rotation
-  std::size_t frame_index = 0;         ///< the frame of each LiDAR used
-  std::size_t base_points = 0, target_points = 0;
+  std::size_t frame_index = 0;         ///< the frame of each LiDAR used (the maps' first)
+  std::size_t base_points = 0, target_points = 0;  ///< of the frames, or of the maps
   std::size_t lattice_size = 0;
-  terra::SearchStats stats;  ///< rotations and seconds per stage, d1 used, ...
-  double seconds = 0.0;      ///< the whole stage, lattice and descriptors included
+  terra::SearchStats stats;       ///< rotations and seconds per stage, d1 used, ...
+  double seconds = 0.0;           ///< the whole stage, lattice, maps and descriptors included
+  std::string source = "frames";  ///< "frames" or "maps": what the kept search compared
+  std::string source_reason;      ///< why (CalibrateOptions::terra_source, automatic rule)
+  /// The single-frame search's mask count and status when it ran (automatic runs it first and
+  /// keeps it unless its overlap is small), whatever source was kept.
+  std::optional<std::size_t> frames_mask_count;
+  std::string frames_status;
+  std::optional<LocalMapStats> base_map, target_map;  ///< when the map search ran
 };
 
 /// The JEEP stage: extrinsic and poses over the first K frame pairs.

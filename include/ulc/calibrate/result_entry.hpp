@@ -33,9 +33,24 @@ inline io::Json stage_stats(const terra::StageStats& s) {
   return j;
 }
 
+inline io::Json local_map_stats(const LocalMapStats& m) {
+  io::Json j = io::Json::object();
+  j["frames"] = m.frames;
+  j["stacked_points"] = m.stacked_points;
+  j["points"] = m.points;
+  j["voxel_m"] = m.voxel_used;
+  j["odometry_status"] = m.odometry_status;
+  j["odometry_reason"] = m.odometry_reason;
+  j["odometry_failed_steps"] = m.odometry_failed_steps;
+  j["seconds"] = m.seconds;
+  return j;
+}
+
 }  // namespace result_detail
 
-/// stages.terra: the search's outcome and the statistics a profiler needs.
+/// stages.terra: the search's outcome and the statistics a profiler needs; "source" says
+/// whether it compared frames or local maps ("base_map" / "target_map" hold the maps'
+/// statistics when the map search ran, "frames_mask_count" the frame search's overlap).
 inline io::Json terra_to_json(const TerraReport& t) {
   using result_detail::stage_stats;
   io::Json j = io::Json::object();
@@ -60,6 +75,14 @@ inline io::Json terra_to_json(const TerraReport& t) {
   j["rotations_evaluated"] = t.stats.rotations();
   j["descriptor_seconds"] = t.stats.descriptor_seconds;
   j["seconds"] = t.seconds;
+  j["source"] = t.source;
+  j["source_reason"] = t.source_reason;
+  if (t.frames_mask_count) {
+    j["frames_mask_count"] = *t.frames_mask_count;
+    j["frames_status"] = t.frames_status;
+  }
+  if (t.base_map) j["base_map"] = result_detail::local_map_stats(*t.base_map);
+  if (t.target_map) j["target_map"] = result_detail::local_map_stats(*t.target_map);
   return j;
 }
 

@@ -3,6 +3,15 @@
 // roll/pitch/yaw in degrees with R = Rz(yaw) Ry(pitch) Rx(roll)), the clock offset, a 6x6
 // covariance, per-stage statistics and timings. A failed calibration still has its entry, with
 // success false, a status word and a human reason.
+//
+// Rig additions (additive: a reader that ignores unknown keys keeps working):
+//   - an entry calibrated through another LiDAR v (ulc/calibrate/rig.hpp) has "via": "<v>" and
+//     "direct": {"status", "reason"} of the failed direct attempt; its T_base_target is the
+//     chain T_base_v * T_v_target, its stages are the v -> target calibration's. Entries
+//     calibrated directly have neither key.
+//   - a top-level "cycles" array next to "results", written when there are cycles:
+//     {"lidars": [base, i, j], "status", "reason", "rotation_deg", "translation_m"}, the closure
+//     error of T_base_i * T_i_j * T_base_j^-1 (null when the i -> j calibration failed).
 #pragma once
 
 #include <Eigen/Geometry>
@@ -28,6 +37,24 @@ struct PairResult {
   std::optional<Eigen::Matrix<double, 6, 6>> covariance_6x6;  ///< tangent order [rho; phi]
   Json stages = Json::object();    ///< {"terra": {...}, "jeep": {...}, "hots": {...}}
   Json timing_s = Json::object();  ///< seconds per stage and "total"
+  std::string via;                 ///< the LiDAR it was calibrated through; empty: direct
+  std::string direct_status;       ///< when routed: the direct attempt's status word
+  std::string direct_reason;       ///< when routed: why the direct attempt failed
+};
+
+/// The cycle base -> i -> j -> base: how far T_base_i * T_i_j * T_base_j^-1 is from identity.
+struct CycleResult {
+  std::vector<std::string> lidars;     ///< {base, i, j}
+  std::string status = "not_run";      ///< of the i -> j calibration
+  std::string reason;                  ///< of the i -> j calibration
+  std::optional<double> rotation_deg;  ///< null unless the i -> j calibration succeeded
+  std::optional<double> translation_m;
+};
+
+/// Everything a result file holds.
+struct ResultDocument {
+  std::vector<PairResult> results;
+  std::vector<CycleResult> cycles;
 };
 
 inline Json to_json(const PairResult& r) {
@@ -47,14 +74,40 @@ inline Json to_json(const PairResult& r) {
   e["covariance_6x6"] = r.covariance_6x6 ? matrix_to_json(*r.covariance_6x6) : Json();
   e["stages"] = r.stages;
   e["timing_s"] = r.timing_s;
+  if (!r.via.empty()) {
+    e["via"] = r.via;
+    Json direct = Json::object();
+    direct["status"] = r.direct_status;
+    direct["reason"] = r.direct_reason;
+    e["direct"] = std::move(direct);
+  }
   return e;
 }
 
-inline Json results_to_json(const std::vector<PairResult>& results) {
+inline Json to_json(const CycleResult& c) {
+  Json e = Json::object();
+  Json lidars = Json::array();
+  for (const auto& name : c.lidars) lidars.push_back(name);
+  e["lidars"] = std::move(lidars);
+  e["status"] = c.status;
+  e["reason"] = c.reason;
+  e["rotation_deg"] = c.rotation_deg ? Json(*c.rotation_deg) : Json();
+  e["translation_m"] = c.translation_m ? Json(*c.translation_m) : Json();
+  return e;
+}
+
+/// {"results": [...]} and, when there are cycles, "cycles": [...].
+inline Json results_to_json(const std::vector<PairResult>& results,
+                            const std::vector<CycleResult>& cycles = {}) {
   Json list = Json::array();
   for (const auto& r : results) list.push_back(to_json(r));
   Json doc = Json::object();
   doc["results"] = std::move(list);
+  if (!cycles.empty()) {
+    Json c = Json::array();
+    for (const auto& cycle : cycles) c.push_back(to_json(cycle));
+    doc["cycles"] = std::move(c);
+  }
   return doc;
 }
 
@@ -87,7 +140,40 @@ inline std::vector<PairResult> results_from_json(const Json& doc, const std::str
       r.covariance_6x6 = json_to_matrix<6, 6>(*c, file, where + ".covariance_6x6");
     if (const Json* s = e.find("stages"); s && s->is_object()) r.stages = *s;
     if (const Json* s = e.find("timing_s"); s && s->is_object()) r.timing_s = *s;
+    if (const Json* v = e.find("via"); v && v->is_string()) r.via = v->as_string();
+    if (const Json* d = e.find("direct"); d && d->is_object()) {
+      if (const Json* s = d->find("status"); s && s->is_string()) r.direct_status = s->as_string();
+      if (const Json* s = d->find("reason"); s && s->is_string()) r.direct_reason = s->as_string();
+    }
     out.push_back(std::move(r));
+  }
+  return out;
+}
+
+/// The top-level "cycles" (empty when the file has none).
+inline std::vector<CycleResult> cycles_from_json(const Json& doc, const std::string& file) {
+  std::vector<CycleResult> out;
+  const Json* list = doc.find("cycles");
+  if (!list) return out;
+  if (!list->is_array()) throw IoError(file, "cycles", "expected an array");
+  for (std::size_t i = 0; i < list->size(); ++i) {
+    const Json& e = (*list)[i];
+    const std::string where = "cycles[" + std::to_string(i) + "]";
+    const Json* lidars = e.is_object() ? e.find("lidars") : nullptr;
+    if (!lidars || !lidars->is_array())
+      throw IoError(file, where, "needs an array \"lidars\" of names");
+    CycleResult c;
+    for (std::size_t k = 0; k < lidars->size(); ++k) {
+      if (!(*lidars)[k].is_string()) throw IoError(file, where + ".lidars", "expected names");
+      c.lidars.push_back((*lidars)[k].as_string());
+    }
+    if (const Json* s = e.find("status"); s && s->is_string()) c.status = s->as_string();
+    if (const Json* s = e.find("reason"); s && s->is_string()) c.reason = s->as_string();
+    if (const Json* x = e.find("rotation_deg"); x && x->is_number())
+      c.rotation_deg = x->as_number();
+    if (const Json* x = e.find("translation_m"); x && x->is_number())
+      c.translation_m = x->as_number();
+    out.push_back(std::move(c));
   }
   return out;
 }
@@ -96,8 +182,15 @@ inline std::vector<PairResult> read_result_file(const std::string& path) {
   return results_from_json(read_json_file(path), path);
 }
 
-inline void write_result_file(const std::string& path, const std::vector<PairResult>& results) {
-  write_json_file(path, results_to_json(results));
+/// The results and the cycles of a result file.
+inline ResultDocument read_result_document(const std::string& path) {
+  const Json doc = read_json_file(path);
+  return {results_from_json(doc, path), cycles_from_json(doc, path)};
+}
+
+inline void write_result_file(const std::string& path, const std::vector<PairResult>& results,
+                              const std::vector<CycleResult>& cycles = {}) {
+  write_json_file(path, results_to_json(results, cycles));
 }
 
 }  // namespace ulc::io

@@ -10,6 +10,8 @@
 //     R = Rz(yaw) Ry(pitch) Rx(roll), the convention of ulc::rpy_from_rotation.
 // Quaternions are given as w x y z (the JSON file's order) and x y z w (ROS message order).
 // Numbers are written with 9 significant digits (sub-micrometre, sub-microradian).
+// A routed entry (result_file.hpp) adds `via` and `direct_status` / `direct_reason`; a rig's
+// cycle closures follow the results as a top-level `cycles` list, the JSON file's fields.
 #pragma once
 
 #include <cstdio>
@@ -55,8 +57,9 @@ std::string list(const V& v) {
 
 }  // namespace yaml_detail
 
-/// The YAML text of `results`.
-inline std::string results_to_yaml(const std::vector<PairResult>& results) {
+/// The YAML text of `results` and, when there are any, `cycles`.
+inline std::string results_to_yaml(const std::vector<PairResult>& results,
+                                   const std::vector<CycleResult>& cycles = {}) {
   using namespace yaml_detail;
   constexpr double kDeg = 180.0 / 3.14159265358979323846;
   std::ostringstream y;
@@ -73,6 +76,11 @@ inline std::string results_to_yaml(const std::vector<PairResult>& results) {
     y << "    success: " << (r.success ? "true" : "false") << "\n";
     y << "    status: " << quoted(r.status) << "\n";
     y << "    reason: " << quoted(r.reason) << "\n";
+    if (!r.via.empty()) {
+      y << "    via: " << quoted(r.via) << "\n";
+      y << "    direct_status: " << quoted(r.direct_status) << "\n";
+      y << "    direct_reason: " << quoted(r.direct_reason) << "\n";
+    }
     y << "    time_offset_s: " << (r.time_offset_s ? num(*r.time_offset_s) : "null") << "\n";
     y << "    T_base_target:\n";
     for (int i = 0; i < 4; ++i)
@@ -99,14 +107,28 @@ inline std::string results_to_yaml(const std::vector<PairResult>& results) {
       << "\" rpy=\"" << num(rpy.x()) << " " << num(rpy.y()) << " " << num(rpy.z()) << "\"/>\n";
     y << "      </joint>\n";
   }
+  if (!cycles.empty()) {
+    y << "# cycle closure: T_base_i * T_i_j * T_base_j^-1, null when i -> j did not calibrate\n";
+    y << "cycles:\n";
+    for (const CycleResult& c : cycles) {
+      y << "  - lidars: [";
+      for (std::size_t k = 0; k < c.lidars.size(); ++k) y << (k ? ", " : "") << quoted(c.lidars[k]);
+      y << "]\n";
+      y << "    status: " << quoted(c.status) << "\n";
+      y << "    reason: " << quoted(c.reason) << "\n";
+      y << "    rotation_deg: " << (c.rotation_deg ? num(*c.rotation_deg) : "null") << "\n";
+      y << "    translation_m: " << (c.translation_m ? num(*c.translation_m) : "null") << "\n";
+    }
+  }
   return y.str();
 }
 
 /// Writes results_to_yaml to `path`; throws IoError when the file cannot be written.
-inline void write_result_yaml(const std::string& path, const std::vector<PairResult>& results) {
+inline void write_result_yaml(const std::string& path, const std::vector<PairResult>& results,
+                              const std::vector<CycleResult>& cycles = {}) {
   std::ofstream out(path, std::ios::binary);
   if (!out) throw IoError(path, "", "cannot open for writing");
-  out << results_to_yaml(results);
+  out << results_to_yaml(results, cycles);
   if (!out.flush()) throw IoError(path, "", "write failed");
 }
 

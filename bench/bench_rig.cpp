@@ -1,0 +1,193 @@
+// bench_rig: whole simulated rigs calibrated with no initial guess (ulc::calibrate_rig), every
+// target against the first LiDAR of the scenario (its base), routed through another target when
+// the direct attempt fails, and the cycles base -> i -> j -> base closed with TERRA + JEEP.
+//
+//   bench_rig [--scenarios ring-5x16,pitched-90,side-bpearl] [--seconds 10]
+//             [--stages terra,jeep,hots] [--decimation 1] [--seed 1] [--threads 2]
+//             [--no-route] [--no-cycles] [--json]
+//
+// Per target: e_rot (deg) and e_trans (cm) against the simulator's mounts, the calibration's
+// status, the route, the clock offset error when HOTS ran, the wall time of its calibrations
+// (direct + routed); "bar" is issue 7's: e_rot < 0.1 deg and e_trans < 2 cm (and status ok).
+// Per cycle: the closure error of T_base_i * T_i_j * T_base_j^-1 and the i -> j status and time.
+// One run per scenario (seed --seed): the figures are single measurements, not medians.
+#include <tbb/task_arena.h>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "support/bench_util.hpp"
+#include "ulc/calibrate/rig.hpp"
+#include "ulc/core/pose_error.hpp"
+#include "ulc/sim/simulate.hpp"
+
+namespace {
+
+using ulc_bench::Cell;
+
+struct Config {
+  std::vector<std::string> scenarios{"ring-5x16", "pitched-90", "side-bpearl"};
+  double seconds = 10.0;
+  std::string stages = "terra,jeep,hots";
+  unsigned decimation = 1;
+  std::uint64_t seed = 1;
+  int threads = 2;
+  bool route = true;
+  bool cycles = true;
+  ulc_bench::Options bench;
+};
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+void bench(const Config& c) {
+  const ulc::ParsedStages stages = ulc::parse_stages(c.stages);
+  if (!stages.ok()) {
+    std::cerr << "bench_rig: --stages: " << stages.error << "\n";
+    std::exit(2);
+  }
+  ulc_bench::Table targets({"scenario", "base", "target", "status", "route", "e_rot_deg",
+                            "e_trans_cm", "dt_error_ms", "bar", "time_s"});
+  ulc_bench::Table cycles(
+      {"scenario", "cycle", "status", "closure_rot_deg", "closure_trans_cm", "time_s"});
+  tbb::task_arena arena(c.threads);
+  for (const auto& name : c.scenarios) {
+    const auto spec = ulc::sim::scenario(name);
+    if (!spec) {
+      std::cerr << "bench_rig: unknown scenario '" << name << "'\n";
+      std::exit(2);
+    }
+    ulc::sim::SimulationOptions so;
+    so.seconds = c.seconds;
+    so.seed = c.seed;
+    so.decimation = c.decimation;
+    auto t0 = std::chrono::steady_clock::now();
+    const ulc::sim::SimulationResult sim =
+        arena.execute([&] { return ulc::sim::simulate(*spec, so); });
+    if (!sim.ok()) {
+      std::cerr << "bench_rig: " << name << ": " << sim.reason << "\n";
+      std::exit(1);
+    }
+    const ulc::sim::Dataset& d = sim.dataset;
+    if (!c.bench.json)
+      std::cerr << name << ": simulated " << d.lidars.size() << " LiDARs, " << c.seconds << " s in "
+                << seconds_since(t0) << " s\n";
+
+    using Frames = std::vector<ulc::PointCloud<float>>;
+    std::vector<ulc::RigLidar<Frames>> lidars;
+    for (const auto& l : d.lidars) lidars.push_back({l.name, &l.frames, &l.timestamps, {}});
+    ulc::RigOptions o;
+    o.pair.stages = stages.stages;
+    o.route = c.route;
+    o.cycles = c.cycles;
+    if (!c.bench.json)
+      o.pair.progress = [last = std::string()](const std::string& stage, double f) mutable {
+        if (stage != last && f == 0.0) std::cerr << "  " << stage << "\n";
+        last = stage;
+      };
+    t0 = std::chrono::steady_clock::now();
+    const ulc::RigCalibration rig = arena.execute([&] { return ulc::calibrate_rig(lidars, 0, o); });
+    if (!c.bench.json)
+      std::cerr << name << ": rig " << ulc::to_string(rig.status) << " in " << seconds_since(t0)
+                << " s\n";
+
+    const auto& base = d.lidars[rig.base];
+    for (const ulc::RigTarget& t : rig.targets) {
+      if (!c.bench.json && !t.direct.success)
+        std::cerr << "  " << t.name << ": direct " << ulc::to_string(t.direct.status) << ": "
+                  << t.direct.reason << "\n  " << t.name << ": result "
+                  << ulc::to_string(t.result.status) << ": " << t.result.reason << "\n";
+      const auto& lidar = d.lidars[t.lidar];
+      const ulc::Isometry3d truth = base.T_vehicle_lidar.inverse() * lidar.T_vehicle_lidar;
+      const ulc::PoseError e = ulc::pose_error(truth, t.result.T_base_target);
+      const bool hots_ran = t.result.hots && t.result.hots->status == "ok";
+      // t_base = t_target + offset; each LiDAR's own clock is t_true - clock_offset.
+      const double true_offset = lidar.clock_offset_s - base.clock_offset_s;
+      const bool bar = t.ok() && e.rotation_deg < 0.1 && e.translation_m < 0.02;
+      targets.add_row(
+          {name, rig.base_name, t.name, ulc::to_string(t.result.status),
+           t.routed() ? "via " + t.via_name : std::string("direct"), Cell::num(e.rotation_deg, 4),
+           Cell::num(100.0 * e.translation_m, 2),
+           hots_ran ? Cell::num(1e3 * (t.result.time_offset_s - true_offset), 2) : Cell("-"),
+           bar ? "yes" : "no", Cell::num(t.result.timing_s.total, 1)});
+    }
+    for (const ulc::RigCycle& cy : rig.cycles) {
+      if (!c.bench.json && !cy.ok())
+        std::cerr << "  cycle " << cy.name_i << "-" << cy.name_j << ": " << cy.pair.reason << "\n";
+      cycles.add_row({name, rig.base_name + ">" + cy.name_i + ">" + cy.name_j,
+                      ulc::to_string(cy.pair.status),
+                      cy.rotation_deg ? Cell::num(*cy.rotation_deg, 4) : Cell("-"),
+                      cy.translation_m ? Cell::num(100.0 * *cy.translation_m, 2) : Cell("-"),
+                      Cell::num(cy.pair.timing_s.total, 1)});
+    }
+  }
+
+  std::string list;
+  for (const auto& s : c.scenarios) list += (list.empty() ? "" : ",") + s;
+  const std::vector<std::pair<std::string, Cell>> parameters{
+      {"scenarios", list},
+      {"seconds", Cell::num(c.seconds, 1)},
+      {"stages", c.stages},
+      {"cycle_stages", "terra,jeep"},
+      {"decimation", Cell::integer(c.decimation)},
+      {"seed", Cell::integer(static_cast<long long>(c.seed))},
+      {"threads", Cell::integer(c.threads)},
+      {"route", c.route ? "on" : "off"},
+      {"initial_guess", "none"}};
+  const std::vector<std::pair<std::string, Cell>> notes{
+      {"bar", "issue 7: status ok and e_rot < 0.1 deg and e_trans < 2 cm"},
+      {"closure", "T_base_i * T_i_j * T_base_j^-1, with T_i_j from terra,jeep on i and j"},
+      {"time_s", "wall time of the target's calibrations (direct + routed) / of the cycle's"}};
+  if (c.bench.json) {
+    std::ostringstream a, b;
+    targets.write_json(a, "bench_rig_targets", ulc_bench::machine(), 1, parameters, notes);
+    cycles.write_json(b, "bench_rig_cycles", ulc_bench::machine(), 1, parameters, notes);
+    std::cout << "{\"targets\": " << a.str() << ", \"cycles\": " << b.str() << "}\n";
+  } else {
+    targets.print(std::cout);
+    std::cout << "\n";
+    cycles.print(std::cout);
+    for (const auto& n : notes) std::cout << n.first << ": " << n.second.text << "\n";
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Config c;
+  std::vector<char*> rest = {argv[0]};
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    const bool value = i + 1 < argc;
+    if (a == "--scenarios" && value) {
+      c.scenarios = ulc_bench::split_list(argv[++i]);
+    } else if (a == "--seconds" && value) {
+      c.seconds = std::atof(argv[++i]);
+    } else if (a == "--stages" && value) {
+      c.stages = argv[++i];
+    } else if (a == "--decimation" && value) {
+      c.decimation = static_cast<unsigned>(std::max(1, std::atoi(argv[++i])));
+    } else if (a == "--seed" && value) {
+      c.seed = std::strtoull(argv[++i], nullptr, 10);
+    } else if (a == "--threads" && value) {
+      c.threads = std::max(1, std::atoi(argv[++i]));
+    } else if (a == "--no-route") {
+      c.route = false;
+    } else if (a == "--no-cycles") {
+      c.cycles = false;
+    } else {
+      rest.push_back(argv[i]);
+    }
+  }
+  c.bench = ulc_bench::parse_options(static_cast<int>(rest.size()), rest.data(),
+                                     "whole rigs with no initial guess (options --scenarios "
+                                     "--seconds --stages --decimation --seed --threads "
+                                     "--no-route --no-cycles)");
+  bench(c);
+  return 0;
+}

@@ -1,0 +1,477 @@
+// The extrinsic and the clock offset from the whole sequence at once, after the pose graph and
+// the time synchronisation (paper Sec. "Pose Refinement by Hierarchical Optimization": "use all
+// data collectively to estimate the extrinsics").
+//
+// Every target frame j is placed in the world through the base's refined trajectory:
+//   z = T_a(t_j + dt) * C * x,    x a point of b's frame j (deskewed to its timestamp t_j),
+// and compared with the base's submaps (point to plane, the paper's eq:pserror). One rigid C
+// and one offset dt explain every frame, so the estimate averages over the whole drive; only
+// the base's poses enter (the target's own poses never do), so the target's odometry errors do
+// not leak into C. Time synchronisation by the extrinsics' spread (time_sync.hpp, the paper's
+// eq:var) gives the starting dt and C; this refines both.
+//
+// Conventions this header owns:
+//   - World = the frame of the base's poses world_a (T_world_a at times_a, a's clock). Clock
+//     offset as in DESIGN.md: t_a = t_b + dt. T_a(t) interpolates world_a (slerp + linear).
+//   - Targets: the base's layer-`target_layer` submaps of the hierarchy (clouds anchored at
+//     their first frame), voxel-thinned at target_voxel, with PCA planes. Frame j's points go
+//     to the submap whose time span holds t_j + dt (else the nearest), as one point-to-plane
+//     term with post = T_world_anchor^-1 T_a(t_j + dt) around the estimated C (left
+//     perturbation, point_to_plane.hpp).
+//   - C and dt are solved together by Gauss-Newton on the 7 parameters [rho; phi; dt]
+//     (robust IRLS weights, matches refreshed every iteration, stages coarse to fine as in
+//     point_to_plane.hpp). The residual's dt column is n . (d post / d dt) y, y = C x, with
+//     d post / d dt by a central difference of the interpolated trajectory (derivative_step_s).
+//     Steps are taken in the Jacobi-scaled eigenbasis of the 7x7 normal matrix, skipping
+//     directions below min_condition: a straight, constant-speed drive cannot tell a clock
+//     offset from a translation along the road, and then dt does not move.
+//   - dt is adopted only when the data pin it down: its standard deviation (cluster-robust
+//     sandwich over blocks of time_cluster_frames target frames, see time_sigma) must be
+//     below max_time_sigma_s and the
+//     estimate must stay within time_window_s of the start; otherwise dt stays at the start and
+//     C is re-solved alone (6 parameters) at that dt. time_offset_refined says which happened.
+//   - The result keeps C and dt of the input when the registration fails (status says why).
+//   - Nothing here throws or prints; the same results for any number of threads (per-term
+//     deterministic reductions summed in term order).
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "hots/hierarchy.hpp"
+#include "hots/time_sync.hpp"
+#include "ulc/core/point_to_plane.hpp"
+#include "ulc/core/registration_target.hpp"
+#include "ulc/core/voxel_downsample.hpp"
+
+namespace hots {
+
+struct SequenceExtrinsicOptions {
+  bool enabled = true;
+  int target_layer = 1;          ///< the base's submaps of this layer (clamped to the hierarchy)
+  double source_voxel = 0.8;     ///< m, each target frame's thinning
+  double target_voxel = 0.15;    ///< m, each base submap's thinning
+  std::size_t frame_stride = 2;  ///< every n-th target frame
+  ulc::PlaneCloudOptions planes;
+  /// Coarse to fine from HOTS's start (millimetres to a few centimetres away).
+  std::vector<ulc::RegistrationOptions> stages = default_stages();
+  bool estimate_time_offset = true;
+  double time_window_s = 0.05;           ///< |dt - start| beyond this: dt not adopted
+  double max_time_sigma_s = 2e-3;        ///< dt adopted only when pinned down this well
+  std::size_t time_cluster_frames = 10;  ///< consecutive target frames sharing their errors
+  double derivative_step_s = 1e-3;       ///< central difference of the trajectory
+  double min_condition = 1e-6;           ///< eigen directions (scaled) skipped below this
+
+  static std::vector<ulc::RegistrationOptions> default_stages() {
+    ulc::RegistrationOptions coarse, fine;
+    coarse.max_correspondence_distance = 0.5;
+    coarse.kernel = ulc::RobustKernel::geman_mcclure(0.1);
+    coarse.max_iterations = 8;
+    coarse.max_solver_iterations = 3;
+    coarse.translation_tolerance = 1e-3;
+    coarse.rotation_tolerance = 1e-4;
+    fine.max_correspondence_distance = 0.25;
+    fine.kernel = ulc::RobustKernel::geman_mcclure(0.03);
+    fine.max_iterations = 8;
+    fine.max_solver_iterations = 3;
+    fine.translation_tolerance = 5e-5;
+    fine.rotation_tolerance = 5e-6;
+    return {coarse, fine};
+  }
+};
+
+enum class SequenceExtrinsicStatus { ok, disabled, invalid_input, registration_failed };
+
+inline const char* to_string(SequenceExtrinsicStatus s) {
+  switch (s) {
+    case SequenceExtrinsicStatus::ok:
+      return "ok";
+    case SequenceExtrinsicStatus::disabled:
+      return "disabled";
+    case SequenceExtrinsicStatus::invalid_input:
+      return "invalid_input";
+    default:
+      return "registration_failed";
+  }
+}
+
+struct SequenceExtrinsicResult {
+  SequenceExtrinsicStatus status = SequenceExtrinsicStatus::disabled;
+  const char* reason = "";
+  Isometry3d extrinsic = Isometry3d::Identity();
+  double time_offset_s = 0.0;
+  bool time_offset_refined = false;  ///< dt was pinned down and adopted
+  double joint_time_offset_s = 0.0;  ///< the 7-parameter solve's dt (adopted or not)
+  double time_sigma_s = 0.0;         ///< its marginal standard deviation (inf: unobservable)
+  std::size_t frames = 0, targets = 0, source_points = 0;
+  std::size_t correspondences = 0, inliers = 0;
+  double rmse = 0.0;   ///< m, inliers at the result
+  double cost = 0.0;   ///< final robust cost at the result
+  int iterations = 0;  ///< matchings, all solves and stages
+
+  bool ok() const { return status == SequenceExtrinsicStatus::ok; }
+};
+
+namespace sequence_detail {
+
+template <typename S>
+using Target = ulc::PlaneCloud<S>;
+
+/// The base's submaps with planes, and each one's anchor frame and time span.
+template <typename S>
+struct BaseSubmaps {
+  std::vector<Target<S>> planes;
+  std::vector<std::size_t> anchor;
+  std::vector<double> start, end;  ///< a's clock
+
+  /// The submap whose span holds t, else the nearest.
+  std::size_t at(double t) const {
+    const auto it = std::upper_bound(start.begin(), start.end(), t);
+    std::size_t k = it == start.begin() ? 0 : static_cast<std::size_t>(it - start.begin()) - 1;
+    if (t > end[k] && k + 1 < start.size() && start[k + 1] - t < t - end[k]) ++k;
+    return k;
+  }
+};
+
+template <typename S>
+BaseSubmaps<S> base_submaps(const HierarchyResult<S>& ha,
+                            const std::vector<std::vector<ulc::Vec3<S>>>& frames_a,
+                            const std::vector<double>& times_a, const SequenceExtrinsicOptions& o) {
+  BaseSubmaps<S> out;
+  if (ha.members.empty()) return out;
+  const std::size_t layer = std::min<std::size_t>(
+      static_cast<std::size_t>(std::max(o.target_layer, 0)), ha.members.size() - 1);
+  const auto& members = ha.members[layer];
+  out.planes.resize(members.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, members.size(), 1),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t k = r.begin(); k != r.end(); ++k) {
+                        const auto& m = members[k];
+                        const auto& cloud = layer == 0 ? frames_a[m.begin] : m.cloud;
+                        auto down = ulc::voxel_downsample(cloud, o.target_voxel);
+                        out.planes[k] = Target<S>(down.ok() ? down.cloud.points : cloud, o.planes);
+                      }
+                    });
+  for (const auto& m : members) {
+    out.anchor.push_back(m.begin);
+    out.start.push_back(times_a[m.begin]);
+    out.end.push_back(times_a[m.end - 1]);
+  }
+  return out;
+}
+
+}  // namespace sequence_detail
+
+namespace sequence_detail {
+
+using Vec7 = Eigen::Matrix<double, 7, 1>;
+using Mat7 = Eigen::Matrix<double, 7, 7>;
+using Mat34 = Eigen::Matrix<double, 3, 4>;
+
+/// What one pass over the matched points sums (7 parameters: [rho; phi; dt]).
+struct JointSums {
+  Mat7 H = Mat7::Zero();
+  Vec7 g = Vec7::Zero();     ///< sum w J r
+  std::vector<Vec7> term_g;  ///< g of each term (for time_sigma), filled by the caller
+  double cost = 0.0;
+  std::size_t count = 0, inliers = 0;
+  double inlier_sq = 0.0;
+
+  JointSums& operator+=(const JointSums& o) {
+    H += o.H;
+    g += o.g;
+    cost += o.cost;
+    count += o.count;
+    inliers += o.inliers;
+    inlier_sq += o.inlier_sq;
+    return *this;
+  }
+  double rmse() const {
+    return inliers ? std::sqrt(inlier_sq / static_cast<double>(inliers)) : 0.0;
+  }
+};
+
+/// post(t) = T_world_anchor^-1 T_a(t) and its time derivative (central difference).
+inline std::pair<Isometry3d, Mat34> placement(const std::vector<double>& times_a,
+                                              const std::vector<Isometry3d>& world_a,
+                                              const Isometry3d& anchor_inverse, double t,
+                                              double h) {
+  const Isometry3d post = anchor_inverse * time_sync_detail::pose_at(times_a, world_a, t);
+  const Isometry3d plus = anchor_inverse * time_sync_detail::pose_at(times_a, world_a, t + h);
+  const Isometry3d minus = anchor_inverse * time_sync_detail::pose_at(times_a, world_a, t - h);
+  const Mat34 d = (plus.matrix() - minus.matrix()).topRows<3>() / (2.0 * h);
+  return {post, d};
+}
+
+/// The point-to-plane residual of x and its Jacobian for C <- exp(xi) C and dt.
+inline double joint_residual(const Vec3d& x, const Isometry3d& C, const Isometry3d& post,
+                             const Mat34& dpost, const ulc::PlaneMatch& plane, Vec7& J) {
+  const Vec3d y = C * x;
+  const Vec3d u = post.linear().transpose() * plane.normal;
+  J.head<3>() = u;
+  J.segment<3>(3) = y.cross(u);
+  J(6) = plane.normal.dot(dpost.leftCols<3>() * y + dpost.col(3));
+  return plane.normal.dot(post * y - plane.point);
+}
+
+/// Step for H d = -g in the Jacobi-scaled eigenbasis, directions below min_condition skipped
+/// (the first n parameters only).
+inline Vec7 truncated_step(const JointSums& s, int n, double min_condition) {
+  Vec7 step = Vec7::Zero();
+  const Eigen::MatrixXd H = s.H.topLeftCorner(n, n);
+  Eigen::VectorXd scale = H.diagonal().cwiseMax(1e-30).cwiseSqrt().cwiseInverse();
+  const Eigen::MatrixXd Hs = scale.asDiagonal() * H * scale.asDiagonal();
+  const Eigen::VectorXd gs = scale.asDiagonal() * s.g.head(n);
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(Hs);
+  const double top = eig.eigenvalues().maxCoeff();
+  Eigen::VectorXd ds = Eigen::VectorXd::Zero(n);
+  for (int i = 0; i < n; ++i) {
+    const double l = eig.eigenvalues()(i);
+    if (!(l > min_condition * top)) continue;
+    const Eigen::VectorXd v = eig.eigenvectors().col(i);
+    ds -= v * (v.dot(gs) / l);
+  }
+  step.head(n) = scale.asDiagonal() * ds;
+  return step;
+}
+
+/// Standard deviation of dt by the cluster-robust ("sandwich") covariance
+/// H^-1 (sum_c g_c g_c^T) H^-1, g_c = sum of w J r over a cluster of consecutive target frames:
+/// points of one frame, and frames close in time, share their errors (a mis-modelled wall, a
+/// pose error), so the textbook sigma^2 H^-1 that treats every point as independent is
+/// optimistic by an order of magnitude. Infinite when dt is not observable.
+inline double time_sigma(const Mat7& H, const std::vector<Vec7>& term_gradients,
+                         std::size_t cluster) {
+  const Eigen::FullPivLU<Mat7> lu(H);
+  if (!lu.isInvertible()) return std::numeric_limits<double>::infinity();
+  const Mat7 Hinv = lu.inverse();
+  Mat7 meat = Mat7::Zero();
+  const std::size_t c = std::max<std::size_t>(cluster, 1);
+  for (std::size_t begin = 0; begin < term_gradients.size(); begin += c) {
+    Vec7 g = Vec7::Zero();
+    for (std::size_t i = begin; i < std::min(begin + c, term_gradients.size()); ++i)
+      g += term_gradients[i];
+    meat.noalias() += g * g.transpose();
+  }
+  const double v = (Hinv * meat * Hinv.transpose())(6, 6);
+  return v >= 0.0 && std::isfinite(v) ? std::sqrt(v) : std::numeric_limits<double>::infinity();
+}
+
+}  // namespace sequence_detail
+
+/// See the header comment. world_a: T_world_a after the pose graph; frames_b: b's prepared
+/// (deskewed, downsampled) frames in b's body frame at times_b.
+template <typename S>
+SequenceExtrinsicResult sequence_extrinsic(const HierarchyResult<S>& ha,
+                                           const std::vector<std::vector<ulc::Vec3<S>>>& frames_a,
+                                           const std::vector<double>& times_a,
+                                           const std::vector<Isometry3d>& world_a,
+                                           const std::vector<std::vector<ulc::Vec3<S>>>& frames_b,
+                                           const std::vector<double>& times_b, const Isometry3d& C0,
+                                           double dt0, const SequenceExtrinsicOptions& o = {}) {
+  namespace d = sequence_detail;
+  SequenceExtrinsicResult result;
+  result.extrinsic = C0;
+  result.time_offset_s = result.joint_time_offset_s = dt0;
+  if (!o.enabled) return result;
+  auto fail = [&](SequenceExtrinsicStatus s, const char* why) {
+    result.status = s;
+    result.reason = why;
+    result.extrinsic = C0;
+    result.time_offset_s = dt0;
+    return result;
+  };
+  if (times_a.size() < 2 || world_a.size() != times_a.size() || frames_a.size() != times_a.size() ||
+      frames_b.size() != times_b.size() || o.stages.empty() || !(o.source_voxel >= 0.0) ||
+      !(o.target_voxel >= 0.0) || !(o.time_window_s >= 0.0) || !(o.derivative_step_s > 0.0) ||
+      !(o.min_condition >= 0.0) || !C0.matrix().allFinite() || !std::isfinite(dt0))
+    return fail(SequenceExtrinsicStatus::invalid_input, "bad inputs or options");
+  for (const auto& stage : o.stages)
+    if (stage.max_iterations < 1 || stage.max_solver_iterations < 1 ||
+        !(stage.max_correspondence_distance > 0.0) || stage.grain < 1)
+      return fail(SequenceExtrinsicStatus::invalid_input, "bad registration stage");
+
+  const d::BaseSubmaps<S> submaps = d::base_submaps(ha, frames_a, times_a, o);
+  if (submaps.planes.empty()) return fail(SequenceExtrinsicStatus::invalid_input, "no submaps");
+  result.targets = submaps.planes.size();
+  std::vector<Isometry3d> anchor_inverse;
+  for (const std::size_t a : submaps.anchor) anchor_inverse.push_back(world_a[a].inverse());
+
+  // Target frames thinned once; their placement depends on dt only.
+  std::vector<std::size_t> used;
+  for (std::size_t j = 0; j < frames_b.size(); j += std::max<std::size_t>(o.frame_stride, 1))
+    used.push_back(j);
+  std::vector<std::vector<ulc::Vec3<S>>> sources(used.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, used.size(), 1),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t k = r.begin(); k != r.end(); ++k) {
+                        const auto& f = frames_b[used[k]];
+                        auto down = ulc::voxel_downsample(f, o.source_voxel);
+                        sources[k] = down.ok() && o.source_voxel > 0.0 ? down.cloud.points : f;
+                      }
+                    });
+
+  using Term = ulc::PointToPlaneTerm<S, d::Target<S>>;
+  std::vector<Term> terms;
+  std::vector<std::size_t> term_frame, term_submap;  // per term: index into used, submap
+  std::vector<d::Mat34> dposts;
+  // Terms at dt; the submaps are chosen afresh only when choose_submaps.
+  auto place = [&](double dt, bool choose_submaps) {
+    if (choose_submaps) {
+      terms.clear();
+      term_frame.clear();
+      term_submap.clear();
+      for (std::size_t k = 0; k < used.size(); ++k) {
+        const double t = times_b[used[k]] + dt;
+        if (t < times_a.front() || t > times_a.back() || sources[k].empty()) continue;
+        const std::size_t m = submaps.at(t);
+        if (submaps.planes[m].empty()) continue;
+        Term term;
+        term.points = sources[k].data();
+        term.size = sources[k].size();
+        term.target = &submaps.planes[m];
+        terms.push_back(term);
+        term_frame.push_back(k);
+        term_submap.push_back(m);
+      }
+    }
+    dposts.resize(terms.size());
+    for (std::size_t i = 0; i < terms.size(); ++i) {
+      const double t = times_b[used[term_frame[i]]] + dt;
+      std::tie(terms[i].post, dposts[i]) =
+          d::placement(times_a, world_a, anchor_inverse[term_submap[i]], t, o.derivative_step_s);
+    }
+  };
+  auto sums_at = [&](const ulc::PointToPlaneMatches& matches, const Isometry3d& C,
+                     const ulc::RegistrationOptions& stage) {
+    d::JointSums total;
+    for (std::size_t i = 0; i < terms.size(); ++i) {
+      const Term& term = terms[i];
+      const auto& planes = matches[i];
+      if (planes.size() != term.size) continue;
+      const auto body = [&](std::size_t begin, std::size_t end, d::JointSums acc) {
+        d::Vec7 J;
+        for (std::size_t p = begin; p < end; ++p) {
+          if (planes[p].normal.squaredNorm() == 0.0) continue;
+          const double r = d::joint_residual(term.points[p].template cast<double>(), C, term.post,
+                                             dposts[i], planes[p], J);
+          const double w = stage.kernel.weight(r);
+          acc.H.noalias() += w * J * J.transpose();
+          acc.g.noalias() += (w * r) * J;
+          acc.cost += stage.kernel.rho(r);
+          ++acc.count;
+          if (std::abs(r) <= stage.inlier_distance) {
+            ++acc.inliers;
+            acc.inlier_sq += r * r;
+          }
+        }
+        return acc;
+      };
+      const auto join = [](d::JointSums a, const d::JointSums& b) {
+        a += b;
+        return a;
+      };
+      const d::JointSums term_sums =
+          ulc::deterministic_reduce(term.size, d::JointSums{}, body, join, stage.grain);
+      total += term_sums;
+      total.term_g.push_back(term_sums.g);
+    }
+    return total;
+  };
+
+  // Gauss-Newton over the stages; with_time: 7 parameters, else C alone.
+  struct Solve {
+    bool ok = false;
+    const char* reason = "";
+    Isometry3d C = Isometry3d::Identity();
+    double dt = 0.0;
+    d::JointSums sums;
+  };
+  auto solve = [&](Isometry3d C, double dt, bool with_time) {
+    Solve out;
+    const int n = with_time ? 7 : 6;
+    ulc::PointToPlaneMatches matches;
+    for (const auto& stage : o.stages) {
+      for (int it = 0; it < stage.max_iterations; ++it) {
+        place(dt, true);
+        const std::size_t found =
+            ulc::match_point_to_plane(terms, C, stage.max_correspondence_distance, matches);
+        ++result.iterations;
+        if (found < stage.min_correspondences) {
+          out.reason = "too few correspondences between the target frames and the base's submaps";
+          return out;
+        }
+        const Isometry3d C_matched = C;
+        const double dt_matched = dt;
+        for (int step = 0; step < stage.max_solver_iterations; ++step) {
+          const d::JointSums s = sums_at(matches, C, stage);
+          const d::Vec7 delta = d::truncated_step(s, n, o.min_condition);
+          const Isometry3d next = ulc::se3_exp(ulc::Vec6d(delta.head<6>())) * C;
+          const bool small =
+              (next.translation() - C.translation()).norm() < stage.translation_tolerance &&
+              ulc::so3_log(next.linear() * C.linear().transpose()).norm() <
+                  stage.rotation_tolerance &&
+              std::abs(delta(6)) < 1e-6;
+          C = next;
+          dt = std::clamp(dt + delta(6), dt0 - 2.0 * o.time_window_s, dt0 + 2.0 * o.time_window_s);
+          if (with_time) place(dt, false);
+          if (small) break;
+        }
+        if ((C.translation() - C_matched.translation()).norm() < stage.translation_tolerance &&
+            ulc::so3_log(C.linear() * C_matched.linear().transpose()).norm() <
+                stage.rotation_tolerance &&
+            std::abs(dt - dt_matched) < 1e-6)
+          break;
+      }
+    }
+    place(dt, true);
+    const auto& last = o.stages.back();
+    ulc::match_point_to_plane(terms, C, last.max_correspondence_distance, matches);
+    out.sums = sums_at(matches, C, last);
+    if (out.sums.count < last.min_correspondences) {
+      out.reason = "too few correspondences between the target frames and the base's submaps";
+      return out;
+    }
+    out.ok = true;
+    out.C = C;
+    out.dt = dt;
+    return out;
+  };
+
+  Solve s = solve(C0, dt0, o.estimate_time_offset);
+  if (!s.ok) return fail(SequenceExtrinsicStatus::registration_failed, s.reason);
+  if (o.estimate_time_offset) {
+    result.joint_time_offset_s = s.dt;
+    result.time_sigma_s = d::time_sigma(s.sums.H, s.sums.term_g, o.time_cluster_frames);
+    result.time_offset_refined =
+        result.time_sigma_s < o.max_time_sigma_s && std::abs(s.dt - dt0) <= o.time_window_s;
+    if (!result.time_offset_refined) {
+      s = solve(C0, dt0, false);
+      if (!s.ok) return fail(SequenceExtrinsicStatus::registration_failed, s.reason);
+    }
+  }
+  result.status = SequenceExtrinsicStatus::ok;
+  result.extrinsic = s.C;
+  result.time_offset_s = s.dt;
+  result.frames = terms.size();
+  for (const auto& t : terms) result.source_points += t.size;
+  result.correspondences = s.sums.count;
+  result.inliers = s.sums.inliers;
+  result.rmse = s.sums.rmse();
+  result.cost = s.sums.cost;
+  return result;
+}
+
+}  // namespace hots

@@ -1,0 +1,203 @@
+// TERRA on local maps (ulc/calibrate/map_terra.hpp) and calibrate_pair's choice between frames
+// and maps (CalibrateOptions::terra_source), on a short simulated 64-tele drive: an HDL-64E
+// base and a Livox Tele-15 target whose single frame fills ~50 lattice cells.
+#include <tbb/task_arena.h>
+#include <catch2/catch.hpp>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "calibrate_test_util.hpp"
+#include "ulc/calibrate.hpp"
+#include "ulc/calibrate/map_terra.hpp"
+#include "ulc/calibrate/result_entry.hpp"
+#include "ulc/core/pose_error.hpp"
+#include "ulc/sim/sim.hpp"
+
+namespace {
+
+using calibrate_test::kDeg;
+
+/// 4.5 s of the seeded 64-tele town drive, every 4th point kept.
+const ulc::sim::Dataset& drive_64_tele() {
+  static const ulc::sim::Dataset d = [] {
+    ulc::sim::SimulationOptions o;
+    o.seconds = 4.5;
+    o.seed = 1;
+    o.decimation = 4;
+    return ulc::sim::simulate(*ulc::sim::scenario("64-tele"), o).dataset;
+  }();
+  return d;
+}
+
+/// The first base frame at or after 1 s (the vehicle is moving by then).
+std::size_t start_index(const ulc::sim::Dataset& d) {
+  std::size_t i = 0;
+  while (i < d.lidars[0].timestamps.size() && d.lidars[0].timestamps[i] < 1.0) ++i;
+  return i;
+}
+
+double error_deg(const ulc::Mat3d& truth, const ulc::Mat3d& R) {
+  return ulc::rotation_error_rad(truth, R) / kDeg;
+}
+
+ulc::CalibrateOptions terra_only(ulc::TerraSource source) {
+  ulc::CalibrateOptions o;
+  o.stages = {ulc::Stage::terra};
+  o.terra_source = source;
+  o.terra_maps.window_s = 3.0;
+  return o;
+}
+
+bool same_bits(const ulc::Mat3d& a, const ulc::Mat3d& b) {
+  return std::memcmp(a.data(), b.data(), 9 * sizeof(double)) == 0;
+}
+
+}  // namespace
+
+TEST_CASE("TERRA on 3 s local maps finds the 64-tele rotation that single frames miss",
+          "[calibrate][map_terra]") {
+  const auto& d = drive_64_tele();
+  REQUIRE(d.lidars.size() == 2);
+  const auto& a = d.lidars[0];
+  const auto& b = d.lidars[1];
+  const std::size_t i = start_index(d);
+  REQUIRE(i + 31 < a.frames.size());
+  REQUIRE(i + 31 < b.frames.size());
+  // Frame i of each LiDAR was taken at about the same instant (the frame search's premise).
+  REQUIRE(std::abs(a.timestamps[i] - b.timestamps[i]) < 0.05);
+  const ulc::Mat3d truth = d.pairs.at(0).T_base_target.linear();
+
+  auto run = [&](ulc::TerraSource s) {
+    ulc::CalibrateOptions o = terra_only(s);
+    o.frame_index = i;
+    return ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, o);
+  };
+  // Single frames: the Tele's ~50 cells overlap the 64's in ~13 at the truth, and chance
+  // matches of 2-5 cells win eq:feature_dis (measured: ~145 deg off).
+  const auto frames = run(ulc::TerraSource::frames);
+  REQUIRE(frames.terra);
+  CHECK(frames.terra->source == "frames");
+  CHECK(!frames.terra->base_map);
+  CHECK(*frames.terra->frames_mask_count < 30);
+  CHECK((!frames.success || error_deg(truth, frames.terra->rotation) > 10.0));
+
+  // Local maps over 3 s (measured: 3.5 deg, ~140 cells in the mask).
+  const auto maps = run(ulc::TerraSource::maps);
+  REQUIRE(maps.success);
+  REQUIRE(maps.terra);
+  CHECK(maps.terra->source == "maps");
+  CHECK(error_deg(truth, maps.terra->rotation) < 5.0);
+  CHECK(maps.terra->mask_count > 5 * *frames.terra->frames_mask_count);
+  REQUIRE(maps.terra->base_map);
+  REQUIRE(maps.terra->target_map);
+  CHECK(maps.terra->base_map->frames == 31);  // 3 s at 10 Hz, both ends
+  CHECK(maps.terra->target_map->frames == 31);
+  CHECK(maps.terra->base_map->odometry_status == "ok");
+  CHECK(maps.terra->target_map->odometry_status == "ok");
+  CHECK(maps.terra->target_map->points > 0);
+  CHECK(maps.terra->target_map->points <= ulc::MapTerraOptions().max_points);
+  CHECK(maps.terra->base_points == maps.terra->base_map->points);
+  CHECK(maps.T_base_target.linear() == maps.terra->rotation);
+
+  // automatic: the frames overlap too little, so it tries the maps and keeps them; same answer.
+  const auto automatic = run(ulc::TerraSource::automatic);
+  REQUIRE(automatic.success);
+  CHECK(automatic.terra->source == "maps");
+  CHECK(same_bits(automatic.terra->rotation, maps.terra->rotation));
+  CHECK(*automatic.terra->frames_mask_count == *frames.terra->frames_mask_count);
+
+  // The result entry says which source, with the maps' statistics.
+  const ulc::io::PairResult r = ulc::to_pair_result(automatic, "lidar64", "tele");
+  const auto& t = r.stages.at("terra");
+  CHECK(t.at("source").as_string() == "maps");
+  CHECK(t.at("frames_mask_count").as_number() ==
+        static_cast<double>(*automatic.terra->frames_mask_count));
+  CHECK(t.at("base_map").at("frames").as_number() == 31.0);
+  CHECK(t.at("target_map").at("points").as_number() ==
+        static_cast<double>(automatic.terra->target_map->points));
+}
+
+TEST_CASE("automatic TERRA stays on frames for single frames and for well-overlapping frames",
+          "[calibrate][map_terra]") {
+  SECTION("one frame per LiDAR (a static snapshot) never builds maps") {
+    const auto& d = drive_64_tele();
+    const std::size_t i = start_index(d);
+    const std::vector<ulc::PointCloud<float>> fa{d.lidars[0].frames[i]}, fb{d.lidars[1].frames[i]};
+    const auto c =
+        ulc::calibrate_pair(fa, {0.0}, fb, {0.0}, terra_only(ulc::TerraSource::automatic));
+    REQUIRE(c.terra);
+    CHECK(c.terra->source == "frames");
+    CHECK(!c.terra->base_map);
+    CHECK(c.terra->source_reason.find("1 frame") != std::string::npos);
+  }
+  SECTION("64-32 frames overlap in hundreds of cells: frames are kept, no map is built") {
+    const auto& d = calibrate_test::drive_64_32();
+    const auto& a = *d.find("lidar64");
+    const auto& b = *d.find("lidar32");
+    ulc::CalibrateOptions o = terra_only(ulc::TerraSource::automatic);
+    o.terra_maps_min_frames = 2;  // the 0.6 s drive has 6 frames: maps would be possible
+    const auto c = ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, o);
+    REQUIRE(c.success);
+    CHECK(c.terra->source == "frames");
+    CHECK(*c.terra->frames_mask_count >= o.terra_maps_below_mask);
+    CHECK(!c.terra->base_map);
+    CHECK(error_deg(d.pairs.at(0).T_base_target.linear(), c.T_base_target.linear()) < 5.0);
+  }
+}
+
+TEST_CASE("TERRA on local maps is identical for 1 and 2 threads", "[calibrate][map_terra]") {
+  const auto& d = drive_64_tele();
+  const std::size_t i = start_index(d);
+  ulc::MapTerraOptions o;
+  o.window_s = 1.0;
+  const terra::Lattice lattice(10000);
+  auto run = [&](int threads) {
+    tbb::task_arena arena(threads);
+    return arena.execute([&] {
+      return ulc::map_terra(lattice, d.lidars[0].frames, d.lidars[0].timestamps, d.lidars[1].frames,
+                            d.lidars[1].timestamps, i, {}, o);
+    });
+  };
+  const ulc::MapTerraResult one = run(1), two = run(2);
+  REQUIRE(one.ok());
+  CHECK(one.base.frames == 11);
+  CHECK(one.base.points == two.base.points);
+  CHECK(one.target.points == two.target.points);
+  CHECK(one.search.mask_count == two.search.mask_count);
+  CHECK(one.search.distance == two.search.distance);
+  CHECK(same_bits(one.search.rotation, two.search.rotation));
+}
+
+TEST_CASE("a local map is the frames stacked in the anchor frame, thinned to its bound",
+          "[calibrate][map_terra]") {
+  const auto& d = drive_64_tele();
+  const std::size_t i = start_index(d);
+  const auto& a = d.lidars[0];
+  ulc::MapTerraOptions o;
+  o.window_s = 0.5;
+  o.max_points = 20000;
+  const auto map = ulc::build_local_map(a.frames, a.timestamps, i, o);
+  REQUIRE(map.ok);
+  CHECK(map.stats.frames == 6);
+  CHECK(map.points.size() <= 20000);
+  CHECK(map.stats.voxel_used > o.voxel);  // the bound forced a coarser voxel
+  // The anchor is the last frame: its own (deskewed, thinned) frame lines up with the map, so
+  // most of its points have a map point within a voxel or two.
+  const auto& last = a.frames[i + 5];
+  std::size_t near = 0, tried = 0;
+  for (std::size_t k = 0; k < last.points.size(); k += 97) {
+    const ulc::Vec3d p = last.points[k].cast<double>();
+    if (p.norm() < 3.0 || p.norm() > 30.0) continue;
+    ++tried;
+    double best = 1e9;
+    for (const auto& q : map.points) best = std::min(best, (q.cast<double>() - p).norm());
+    near += best < 2.0 * map.stats.voxel_used;
+  }
+  REQUIRE(tried > 50);
+  CHECK(static_cast<double>(near) > 0.8 * static_cast<double>(tried));
+  // No window past the end.
+  const auto none = ulc::build_local_map(a.frames, a.timestamps, a.frames.size(), o);
+  CHECK(!none.ok);
+  CHECK(none.points.empty());
+}

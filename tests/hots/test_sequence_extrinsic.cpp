@@ -1,0 +1,137 @@
+// The whole-sequence step of HOTS (sequence_extrinsic.hpp): its 7-parameter Jacobian against
+// finite differences, and the extrinsic recovered from the base's true trajectory on a
+// simulated 64-32 drive, the same for 1 and 2 threads.
+#include <tbb/task_arena.h>
+#include <catch2/catch.hpp>
+#include <random>
+#include <vector>
+
+#include "hots/hots.hpp"
+#include "hots/sequence_extrinsic.hpp"
+#include "hots_drive.hpp"
+#include "hots_test_util.hpp"
+#include "ulc/core/pose_error.hpp"
+
+namespace {
+
+using hots_test::kDeg;
+using ulc::Isometry3d;
+using ulc::Vec3d;
+
+struct Prepared {
+  std::vector<std::vector<ulc::Vec3<float>>> fa, fb;
+  hots::HierarchyResult<float> ha;
+};
+
+/// The base's frames and hierarchy from its true poses, the target's frames deskewed by truth.
+const Prepared& prepared() {
+  static const Prepared p = [] {
+    const auto& d = hots_drive::drive();
+    const auto& a = d.data.lidars[0];
+    const auto& b = d.data.lidars[1];
+    Prepared out;
+    out.fa = hots::hots_detail::prepare_frames<float>(a.frames, a.timestamps, d.truth_a, 0.1);
+    out.fb = hots::hots_detail::prepare_frames<float>(b.frames, b.timestamps, d.truth_b, 0.1);
+    out.ha = hots::build_hierarchy(out.fa, d.truth_a, hots::HierarchyOptions{});
+    return out;
+  }();
+  return p;
+}
+
+}  // namespace
+
+TEST_CASE("the joint residual's Jacobian matches finite differences in C and dt",
+          "[hots][sequence]") {
+  std::mt19937_64 rng(11);
+  const std::vector<double> times{0.0, 0.1, 0.2, 0.3};
+  std::vector<Isometry3d> poses{hots_test::random_pose(rng, 0.3, 2.0)};
+  for (int k = 1; k < 4; ++k)
+    poses.push_back(poses.back() * hots_test::random_pose(rng, 5 * kDeg, 1.0));
+  const Isometry3d anchor_inverse = hots_test::random_pose(rng, 0.5, 3.0);
+  const Isometry3d C = hots_test::random_pose(rng, 0.5, 1.0);
+  const Vec3d x(4.0, -2.0, 1.5);
+  ulc::PlaneMatch plane;
+  plane.normal = Vec3d(0.3, -0.5, 0.8).normalized();
+  plane.point = Vec3d(1.0, 2.0, -1.0);
+  const double t = 0.137, h = 1e-4;
+
+  const auto [post, dpost] = hots::sequence_detail::placement(times, poses, anchor_inverse, t, h);
+  hots::sequence_detail::Vec7 J, unused;
+  const double r = hots::sequence_detail::joint_residual(x, C, post, dpost, plane, J);
+  const double eps = 1e-6;
+  for (int i = 0; i < 6; ++i) {
+    ulc::Vec6d xi = ulc::Vec6d::Zero();
+    xi[i] = eps;
+    const double rp =
+        hots::sequence_detail::joint_residual(x, ulc::se3_exp(xi) * C, post, dpost, plane, unused);
+    xi[i] = -eps;
+    const double rm =
+        hots::sequence_detail::joint_residual(x, ulc::se3_exp(xi) * C, post, dpost, plane, unused);
+    CHECK(J[i] == Approx((rp - rm) / (2 * eps)).margin(1e-6));
+  }
+  // dt: the residual with the trajectory read at t +- eps.
+  auto at = [&](double tt) {
+    const auto pd = hots::sequence_detail::placement(times, poses, anchor_inverse, tt, h);
+    return hots::sequence_detail::joint_residual(x, C, pd.first, pd.second, plane, unused);
+  };
+  CHECK(J[6] == Approx((at(t + 1e-5) - at(t - 1e-5)) / 2e-5).epsilon(1e-6));
+  CHECK(r == Approx(at(t)));
+}
+
+TEST_CASE("the whole-sequence step recovers the extrinsic from the base's true trajectory",
+          "[hots][sequence]") {
+  const auto& d = hots_drive::drive();
+  const auto& a = d.data.lidars[0];
+  const auto& b = d.data.lidars[1];
+  const Prepared& p = prepared();
+  const Isometry3d C_gt = d.data.pairs[0].T_base_target;
+  std::mt19937_64 rng(5);
+  const Isometry3d C0 = jeep_test::disturbed(C_gt, rng, 0.3 * kDeg, 0.05);
+  hots::SequenceExtrinsicOptions o;
+  o.estimate_time_offset = false;
+  auto run = [&] {
+    return hots::sequence_extrinsic(p.ha, p.fa, a.timestamps, d.truth_a, p.fb, b.timestamps, C0,
+                                    0.0, o);
+  };
+  const hots::SequenceExtrinsicResult r = run();
+  INFO(hots::to_string(r.status) << ": " << r.reason);
+  REQUIRE(r.ok());
+  const auto e0 = ulc::pose_error(C_gt, C0);
+  const auto e = ulc::pose_error(C_gt, r.extrinsic);
+  INFO("start " << e0.rotation_deg << " deg " << e0.translation_m << " m; result " << e.rotation_deg
+                << " deg " << e.translation_m << " m; frames " << r.frames << " points "
+                << r.source_points << " rmse " << r.rmse);
+  CHECK(e.rotation_deg < 0.02);
+  CHECK(e.translation_m < 0.005);
+  CHECK(r.time_offset_s == 0.0);
+  CHECK_FALSE(r.time_offset_refined);
+  CHECK(r.frames > 10);
+
+  tbb::task_arena one(1), two(2);
+  const auto r1 = one.execute(run);
+  const auto r2 = two.execute(run);
+  CHECK(r1.extrinsic.matrix() == r2.extrinsic.matrix());
+  CHECK(r1.cost == r2.cost);
+}
+
+TEST_CASE("the whole-sequence step refuses bad input and can be switched off", "[hots][sequence]") {
+  const auto& d = hots_drive::drive();
+  const auto& a = d.data.lidars[0];
+  const auto& b = d.data.lidars[1];
+  const Prepared& p = prepared();
+  const Isometry3d C = d.data.pairs[0].T_base_target;
+  hots::SequenceExtrinsicOptions off;
+  off.enabled = false;
+  const auto r0 = hots::sequence_extrinsic(p.ha, p.fa, a.timestamps, d.truth_a, p.fb, b.timestamps,
+                                           C, 0.0, off);
+  CHECK(r0.status == hots::SequenceExtrinsicStatus::disabled);
+  CHECK(r0.extrinsic.matrix() == C.matrix());
+  hots::SequenceExtrinsicOptions bad;
+  bad.stages.clear();
+  CHECK(
+      hots::sequence_extrinsic(p.ha, p.fa, a.timestamps, d.truth_a, p.fb, b.timestamps, C, 0.0, bad)
+          .status == hots::SequenceExtrinsicStatus::invalid_input);
+  const std::vector<Isometry3d> short_poses(d.truth_a.begin(), d.truth_a.begin() + 2);
+  CHECK(hots::sequence_extrinsic(p.ha, p.fa, a.timestamps, short_poses, p.fb, b.timestamps, C, 0.0)
+            .status == hots::SequenceExtrinsicStatus::invalid_input);
+}
