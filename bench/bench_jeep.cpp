@@ -323,14 +323,15 @@ void separation(Config c) {
                      Cell::num(mn(condition), 4), Cell::num(jeep_test::median(condition), 4)});
     }
   }
-  emit(table, "bench_jeep_separation", c,
-       {{"scenarios", scenario_list(c)},
-        {"starts", Cell::integer(static_cast<long long>(c.starts))},
-        {"frames", Cell::integer(static_cast<long long>(c.frames))}},
-       {{"overlap", "agreeing / near points of map b (acceptance.hpp); settled runs only"},
-        {"rule",
-         "accept iff overlap >= " + std::to_string(jeep::AcceptanceOptions{}.min_overlap) +
-             " and condition >= " + std::to_string(jeep::AcceptanceOptions{}.min_condition)}});
+  emit(
+      table, "bench_jeep_separation", c,
+      {{"scenarios", scenario_list(c)},
+       {"starts", Cell::integer(static_cast<long long>(c.starts))},
+       {"frames", Cell::integer(static_cast<long long>(c.frames))}},
+      {{"overlap", "agreeing / near points of the smaller map (acceptance.hpp); settled runs only"},
+       {"rule",
+        "accept iff overlap >= " + std::to_string(jeep::AcceptanceOptions{}.min_overlap) +
+            " and condition >= " + std::to_string(jeep::AcceptanceOptions{}.min_condition)}});
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -39,8 +39,19 @@ namespace hots {
 struct HierarchyOptions {
   std::size_t window = 5;
   int layers = 3;
-  WindowBaOptions ba;
-  double submap_voxel = 0.1;  ///< m
+  /// One plane extraction per window, in 2 m root voxels: the odometry's poses are already
+  /// within centimetres, so the second extraction (window_ba.hpp, rounds) halved the
+  /// hierarchy's speed and 1 m roots (more, smaller planes) cost a third more, for nothing
+  /// measurable on the 64-32 and 64-horizon drives (docs/BENCHMARKS.md, bench_hots).
+  WindowBaOptions ba = hots_window_ba();
+  double submap_voxel = 0.2;  ///< m
+
+  static WindowBaOptions hots_window_ba() {
+    WindowBaOptions o;
+    o.rounds = 1;
+    o.planes.voxel_size = 2.0;
+    return o;
+  }
   /// Floor of the BA noise estimate (m): a near-perfect window does not dominate the graph.
   double min_sigma = 1e-3;
 };

@@ -62,8 +62,8 @@ struct SequenceExtrinsicOptions {
   bool enabled = true;
   int target_layer = 1;          ///< the base's submaps of this layer (clamped to the hierarchy)
   double source_voxel = 0.8;     ///< m, each target frame's thinning
-  double target_voxel = 0.15;    ///< m, each base submap's thinning
-  std::size_t frame_stride = 2;  ///< every n-th target frame
+  double target_voxel = 0.3;     ///< m, each base submap's thinning
+  std::size_t frame_stride = 4;  ///< every n-th target frame (2.5 per second at 10 Hz)
   ulc::PlaneCloudOptions planes;
   /// Coarse to fine from HOTS's start (millimetres to a few centimetres away).
   std::vector<ulc::RegistrationOptions> stages = default_stages();

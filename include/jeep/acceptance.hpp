@@ -2,9 +2,16 @@
 // merely settle somewhere?
 //
 // Conventions this header owns:
-//   - Evidence is taken at the final C from map b (source) against map a's planes (target),
-//     with map b voxel-downsampled at `voxel`:
-//       near      = points of map b with a plane of map a within `gate`;
+//   - Which map is measured is a property of the pair, not of the roles: both maps are
+//     voxel-downsampled at `voxel`, and the one with fewer points (the map that covers less;
+//     a tie keeps map b) is measured against the PCA planes of the other (built as
+//     map_registration.hpp's map_target does), at C when map b is measured and at C^-1 when
+//     map a is. Why: points of the larger map near the smaller map's few planes include all
+//     the smaller unit never saw (occlusion, shorter range), which disagree at the truth;
+//     measuring the larger map would reject a correct result depending only on which LiDAR is
+//     called base. This way assess(a, b, C) and assess(b, a, C^-1) decide alike.
+//   - Evidence, for the measured map at the final extrinsic:
+//       near      = its points with a plane of the other map within `gate`;
 //       agreeing  = near points with |point-to-plane residual| <= inlier_distance;
 //       overlap   = agreeing / near: how much of what both maps cover, they agree on;
 //       condition = lambda_min / lambda_max of the scaled, centred Hessian of the agreeing
@@ -18,16 +25,19 @@
 //     the near points that disagree are only the clutter of edges, thin objects and occlusion
 //     borders: a minority. Unrelated scenes agree on the ground and on whatever wall happens
 //     to coincide. min_overlap = 0.6 sits between the two, as measured by bench_jeep
-//     --separation (10 starts per pair, true vs unrelated data, 2026-11-21): true medians
-//     0.83 (64-32), 0.67 (32-16), 0.66 (32-avia), 0.78 (64-horizon); unrelated maxima 0.56,
-//     0.41, 0.50, 0.64. Sparse maps (VLP-16, Avia) agree less at the truth: the former 0.7
-//     rejected 74% of correct 32-16 results and 88% of correct 32-avia ones. With a Tele the
-//     two distributions overlap (true 0.50-0.98, unrelated 0.22-0.83): the rule cannot tell
-//     them apart there, and says so only through the Tele pairs' false accepts in the bench. min_condition is the registration's own degeneracy threshold: an alignment
-//     resting on the ground alone is not a calibration. bench_jeep --separation measures both
-//     distributions on the paper's pairs (DESIGN.md: measure, do not guess).
+//     --separation (10 starts per pair, true vs unrelated data, 2026-11-21, when map b was
+//     always the one measured): true medians 0.83 (64-32), 0.67 (32-16), 0.66 (32-avia), 0.78
+//     (64-horizon); unrelated maxima 0.56, 0.41, 0.50, 0.64. Sparse maps (VLP-16, Avia) agree
+//     less at the truth: the former 0.7 rejected 74% of correct 32-16 results and 88% of
+//     correct 32-avia ones. With a Tele the two distributions overlap (true 0.50-0.98,
+//     unrelated 0.22-0.83): the rule cannot tell them apart there, and says so only through
+//     the Tele pairs' false accepts in the bench. min_condition is the registration's own
+//     degeneracy threshold: an alignment resting on the ground alone is not a calibration.
+//     bench_jeep --separation measures both distributions on the paper's pairs (DESIGN.md:
+//     measure, do not guess).
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <vector>
@@ -43,8 +53,8 @@
 namespace jeep {
 
 struct AcceptanceOptions {
-  double voxel = 0.5;            ///< m, map b's resolution for the evidence
-  double gate = 1.0;             ///< m, "near": a map-a plane within this
+  double voxel = 0.5;            ///< m, both maps' resolution for the evidence
+  double gate = 1.0;             ///< m, "near": a plane of the other map within this
   double inlier_distance = 0.1;  ///< m, "agreeing": the success threshold of the paper
   double min_overlap = 0.6;
   double min_condition = 1e-3;  ///< as RegistrationOptions::min_condition
@@ -54,12 +64,14 @@ struct AcceptanceOptions {
 struct AcceptanceReport {
   bool accepted = false;
   const char* reason = "";
-  std::size_t points = 0;    ///< map b points examined
-  std::size_t near = 0;      ///< with a map-a plane within the gate
-  std::size_t agreeing = 0;  ///< of those, within inlier_distance of it
-  double overlap = 0.0;      ///< agreeing / near
-  double condition = 0.0;    ///< of the agreeing points' Hessian
-  double rmse = 0.0;         ///< m, RMS residual of the agreeing points
+  bool measured_a = false;       ///< map a was the smaller map, measured against map b's planes
+  std::size_t points = 0;        ///< points of the measured map examined (at `voxel`)
+  std::size_t other_points = 0;  ///< the other map's points at `voxel` (decided the orientation)
+  std::size_t near = 0;          ///< with a plane of the other map within the gate
+  std::size_t agreeing = 0;      ///< of those, within inlier_distance of it
+  double overlap = 0.0;          ///< agreeing / near
+  double condition = 0.0;        ///< of the agreeing points' Hessian
+  double rmse = 0.0;             ///< m, RMS residual of the agreeing points
 };
 
 namespace detail {
@@ -76,31 +88,26 @@ struct AgreementSums {
   }
 };
 
-}  // namespace detail
-
+/// Fills near, agreeing, overlap, condition and rmse: `points` moved by `pose` onto `planes`.
 template <typename S>
-AcceptanceReport assess(const std::vector<Vec3<S>>& /*map_a*/, const std::vector<Vec3<S>>& map_b,
-                        const ulc::PlaneCloud<S>& target, const Isometry3d& C,
-                        const RegistrationResult<double>& /*calibration*/,
-                        const AcceptanceOptions& options) {
-  AcceptanceReport report;
-  const ulc::PointCloud<S> points = downsampled(map_b, options.voxel);
-  report.points = points.size();
+void measure_agreement(const ulc::PointCloud<S>& points, const ulc::PlaneCloud<S>& planes,
+                       const Isometry3d& pose, const AcceptanceOptions& options,
+                       AcceptanceReport& report) {
   using Term = ulc::PointToPlaneTerm<S, ulc::PlaneCloud<S>>;
   const std::vector<Term> terms{
-      Term{points.points.data(), points.size(), &target, C, Isometry3d::Identity(), 1.0}};
+      Term{points.points.data(), points.size(), &planes, pose, Isometry3d::Identity(), 1.0}};
   ulc::PointToPlaneMatches matches;
   report.near = ulc::match_point_to_plane(terms, Isometry3d::Identity(), options.gate, matches);
-  const ulc::PointToPlaneGeometry geometry(C, Isometry3d::Identity(), Isometry3d::Identity());
-  const auto& planes = matches[0];
+  const ulc::PointToPlaneGeometry geometry(pose, Isometry3d::Identity(), Isometry3d::Identity());
+  const auto& matched = matches[0];
   const auto sums = ulc::deterministic_reduce(
-      points.size(), detail::AgreementSums{},
-      [&](std::size_t begin, std::size_t end, detail::AgreementSums acc) {
+      points.size(), AgreementSums{},
+      [&](std::size_t begin, std::size_t end, AgreementSums acc) {
         ulc::Vec6d J;
         for (std::size_t i = begin; i < end; ++i) {
-          if (planes[i].normal.squaredNorm() == 0.0) continue;
+          if (matched[i].normal.squaredNorm() == 0.0) continue;
           const ulc::Vec3d y = geometry.pose_frame(points.points[i].template cast<double>());
-          const double r = geometry.residual(y, y, planes[i], &J);
+          const double r = geometry.residual(y, y, matched[i], &J);
           if (std::abs(r) > options.inlier_distance) continue;
           acc.equations.add(J, r);
           acc.sum_y += y;
@@ -108,7 +115,7 @@ AcceptanceReport assess(const std::vector<Vec3<S>>& /*map_a*/, const std::vector
         }
         return acc;
       },
-      [](detail::AgreementSums a, const detail::AgreementSums& b) {
+      [](AgreementSums a, const AgreementSums& b) {
         a += b;
         return a;
       },
@@ -122,10 +129,38 @@ AcceptanceReport assess(const std::vector<Vec3<S>>& /*map_a*/, const std::vector
     report.condition = ulc::scaled_condition(sums.equations.H, c, spread);
     report.rmse = std::sqrt(sums.equations.cost / n);
   }
+}
+
+}  // namespace detail
+
+/// Judges C = T_a_b (map b's frame to map a's). `planes_a` is map_target(map_a, planes); map
+/// b's planes are built with the same options, and only when map b is the larger map.
+template <typename S>
+AcceptanceReport assess(const std::vector<Vec3<S>>& map_a, const std::vector<Vec3<S>>& map_b,
+                        const ulc::PlaneCloud<S>& planes_a, const MapRegistrationOptions& planes,
+                        const Isometry3d& C, const AcceptanceOptions& options) {
+  AcceptanceReport report;
+  ulc::PointCloud<S> points_a = downsampled(map_a, options.voxel);
+  ulc::PointCloud<S> points_b = downsampled(map_b, options.voxel);
+  report.measured_a = points_a.size() < points_b.size();
+  if (report.measured_a) {
+    report.points = points_a.size();
+    report.other_points = points_b.size();
+    points_b = ulc::PointCloud<S>();  // only its count was needed
+    const ulc::PlaneCloud<S> planes_b = map_target(map_b, planes);
+    detail::measure_agreement(points_a, planes_b, C.inverse(), options, report);
+  } else {
+    report.points = points_b.size();
+    report.other_points = points_a.size();
+    points_a = ulc::PointCloud<S>();
+    detail::measure_agreement(points_b, planes_a, C, options, report);
+  }
   if (report.agreeing < options.min_agreeing) {
-    report.reason = "too few points of map b agree with map a";
+    report.reason = "too few points of the smaller map agree with the larger one";
   } else if (report.overlap < options.min_overlap) {
-    report.reason = "where the maps overlap, most of map b does not lie on map a's surfaces";
+    report.reason =
+        "where the maps overlap, most of the smaller map does not lie on the larger one's "
+        "surfaces";
   } else if (report.condition < options.min_condition) {
     report.reason = "the points on which the maps agree leave a direction unconstrained";
   } else {

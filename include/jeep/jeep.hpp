@@ -265,7 +265,7 @@ JeepResult run_jeep(const FramesA& frames_a, const std::vector<double>& times_a,
                 trace.change_rotation < options.settle_rotation;
     previous_poses = poses_a;
     if (settled || round == options.max_rounds) {
-      result.acceptance = assess(map_a, map_b, target, C, calibration, options.acceptance);
+      result.acceptance = assess(map_a, map_b, target, options.calibration, C, options.acceptance);
       // In the output poses' frames (see to_first below).
       const Isometry3d to_first = poses_a[0].inverse();
       const Isometry3d to_first_b = C.inverse() * to_first * C;

@@ -80,7 +80,7 @@ ScanScanResult scan_to_scan(const CloudA& scan_a, const CloudB& scan_b, const Is
   }
   result.extrinsic = result.registration.pose;
   result.acceptance =
-      assess(a.dense, b.dense, target, result.extrinsic, result.registration, options.acceptance);
+      assess(a.dense, b.dense, target, options.registration, result.extrinsic, options.acceptance);
   if (!result.acceptance.accepted) {
     result.status = ScanScanStatus::rejected;
     result.reason = result.acceptance.reason;

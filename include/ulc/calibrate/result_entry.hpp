@@ -139,6 +139,14 @@ inline io::Json hots_to_json(const HotsReport& h) {
     curve.push_back(std::move(point));
   }
   j["spread_curve"] = std::move(curve);  // [[offset_s, spread], ...]
+  io::Json phases = io::Json::object();
+  phases["prepare"] = s.prepare_seconds;
+  phases["hierarchy"] = s.hierarchy_seconds;
+  phases["cross_links"] = s.links_seconds;
+  phases["graph"] = s.graph_seconds;
+  phases["time_sync"] = s.sync_seconds;
+  phases["sequence"] = s.sequence_seconds;
+  j["phase_seconds"] = std::move(phases);
   j["odometry_seconds"] = h.odometry_seconds;
   j["seconds"] = h.seconds;
   return j;
