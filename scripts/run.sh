@@ -5,10 +5,13 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install_deps.sh
 jobs=${ULC_JOBS:-$(nproc)}
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DULC_BUILD_TESTS=OFF -DULC_BUILD_BENCH=OFF
-cmake --build build -j "$jobs" --target ulc_app example_custom_point_type
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DULC_BUILD_TESTS=OFF -DULC_BUILD_BENCH=OFF \
+  -DULC_BUILD_APPS=ON -DULC_BUILD_EXAMPLES=ON
+cmake --build build -j "$jobs" --target ulc_app example_custom_point_type example_calibrate_own_points
 ulc=./build/apps/ulc/ulc
 ./build/examples/example_custom_point_type
+# The whole calibration on a user's own point struct, checked against the simulator's truth.
+./build/examples/example_calibrate_own_points
 out=${ULC_OUT:-/tmp/ulc_demo}
 $ulc simulate --scenario 64-horizon --seconds 6 --seed 1 --out "$out/64-horizon" \
   --preview "$out/64-horizon_preview.png"
