@@ -3,6 +3,7 @@
 //
 //   bench_hots --accuracy    [--scenarios 64-32,...] [--seconds 60] [--runs 10]
 //   bench_hots --time-offset [--scenarios 64-32,64-horizon] [--seconds 60] [--runs 10]
+//                            [--spread-png PREFIX]
 //   common: [--decimation 1] [--threads 2] [--json]
 //
 // Each run simulates the drive with seed = run index + 1, disturbs the truth by 5 deg about a
@@ -11,7 +12,11 @@
 // same odometry and refine options as ulc::CalibrateOptions' defaults) so that the poses are at
 // hand for the trajectory error. Success: HOTS ok and e_rot < 1 deg and e_trans < 10 cm.
 // Medians are over all runs, failures included. --time-offset runs each scenario with the
-// target's clock 50 ms behind (the paper's figure) and with no offset.
+// target's clock 50 ms behind (the paper's figure) and with no offset. --spread-png PREFIX
+// writes run 0's spread-against-offset curve (HOTS's last time synchronisation pass) of each
+// scenario and offset to PREFIX_<scenario>_<offset_ms>ms.png: x the candidate offset in ms,
+// y the corrected spread in cm^2, a solid green line at the true offset and a dashed red one at
+// HOTS's final estimate (support/curve_png.hpp).
 // ATE: RMS translation error of the base LiDAR's poses (odometry's, then HOTS's) against the
 // simulator's trajectory, both in the base frame at its first timestamp.
 // A 60 s full-rate drive holds every frame in memory (several GB for 64-beam rigs):
@@ -33,6 +38,7 @@
 #include "hots/hots.hpp"
 #include "jeep/run_odometry.hpp"
 #include "support/bench_util.hpp"
+#include "support/curve_png.hpp"
 #include "ulc/calibrate.hpp"
 #include "ulc/core/pose_error.hpp"
 #include "ulc/sim/simulate.hpp"
@@ -50,6 +56,7 @@ struct Config {
   std::size_t runs = 10;
   unsigned decimation = 1;
   int threads = 2;
+  std::string spread_png;  ///< prefix of the spread curve pictures; empty: none
   ulc_bench::Options bench;
 };
 
@@ -87,6 +94,8 @@ struct Run {
   hots::SequenceExtrinsicResult sequence;
   double sequence_s = 0.0;
   double odometry_s = 0.0, hots_s = 0.0;
+  double true_offset_s = 0.0, hots_offset_s = 0.0;
+  std::vector<std::pair<double, double>> spread_curve;  ///< (offset s, spread m^2), HOTS's
 };
 
 Run one_run(const std::string& scenario, double offset_s, std::size_t run, const Config& c) {
@@ -102,6 +111,7 @@ Run one_run(const std::string& scenario, double offset_s, std::size_t run, const
   const auto& b = d.lidars.at(1);
   const Isometry3d truth = d.pairs.at(0).T_base_target;
   const double true_offset = d.pairs.at(0).time_offset_s;
+  out.true_offset_s = true_offset;
   std::mt19937_64 rng(1000003ULL * (run + 1));
   const Isometry3d initial = jeep_test::disturbed(truth, rng, 5.0 * kDeg, 2.0);
 
@@ -136,6 +146,8 @@ Run one_run(const std::string& scenario, double offset_s, std::size_t run, const
     if (!h.ok()) return;
     out.hots_error = ulc::pose_error(truth, h.extrinsic);
     out.dt_error_s = h.time_offset_s - true_offset;
+    out.hots_offset_s = h.time_offset_s;
+    out.spread_curve = h.spread_curve;
     out.sync_error = ulc::pose_error(truth, h.statistics.sync_extrinsic);
     out.sequence = h.statistics.sequence;
     out.sequence_s = h.statistics.sequence_seconds;
@@ -154,6 +166,24 @@ void emit(const ulc_bench::Table& table, const std::string& name, const Config& 
     table.print(std::cout);
     for (const auto& n : notes) std::cout << n.first << ": " << n.second.text << "\n";
   }
+}
+
+/// Run `r`'s spread curve to PREFIX_<scenario>_<offset_ms>ms.png (see the header comment).
+void write_spread_png(const Run& r, const std::string& scenario, double offset_s, const Config& c) {
+  const std::string path = c.spread_png + "_" + scenario + "_" +
+                           std::to_string(static_cast<long long>(std::lround(offset_s * 1e3))) +
+                           "ms.png";
+  ulc_bench::CurvePlot plot;
+  plot.series.push_back({"spread", {}});
+  for (const auto& [dt, spread] : r.spread_curve)
+    plot.series.back().points.emplace_back(dt * 1e3, spread * 1e4);
+  plot.markers.push_back({"true offset", r.true_offset_s * 1e3, false});
+  if (r.hots_ok) plot.markers.push_back({"HOTS estimate", r.hots_offset_s * 1e3, true});
+  if (ulc_bench::write_curve_png(path, plot))
+    std::cerr << "bench_hots: wrote " << path << "\n";
+  else
+    std::cerr << "bench_hots: no spread curve written to " << path
+              << " (HOTS did not synchronise, or the file cannot be written)\n";
 }
 
 void bench(Config c) {
@@ -208,6 +238,7 @@ void bench(Config c) {
                     << r.sequence.time_offset_refined << ", " << r.sequence.iterations
                     << " matchings, " << r.sequence.source_points << " points, " << r.sequence_s
                     << " s\n";
+        if (offsets && run == 0 && !c.spread_png.empty()) write_spread_png(r, scenario, offset, c);
       }
       const double n = static_cast<double>(c.runs);
       using jeep_test::median;
@@ -260,6 +291,8 @@ int main(int argc, char** argv) {
       c.decimation = static_cast<unsigned>(std::max(1, std::atoi(argv[++i])));
     } else if (a == "--threads" && value) {
       c.threads = std::max(1, std::atoi(argv[++i]));
+    } else if (a == "--spread-png" && value) {
+      c.spread_png = argv[++i];
     } else {
       rest.push_back(argv[i]);
     }
@@ -267,7 +300,7 @@ int main(int argc, char** argv) {
   c.bench = ulc_bench::parse_options(static_cast<int>(rest.size()), rest.data(),
                                      "HOTS after JEEP on simulated drives (modes: --accuracy "
                                      "--time-offset; options --scenarios --seconds --runs "
-                                     "--decimation --threads)");
+                                     "--decimation --threads --spread-png)");
   bench(c);
   return 0;
 }

@@ -2,12 +2,10 @@
 // (row, column) value in [0, 100], red (0) through yellow to green (100), the value written in
 // the cell, row and column labels along the left and bottom edges. Digits, '.', '-', '%' only
 // (a 3x5 pixel font): the axis names go in the caption of the document that shows the picture.
-// One translation unit per benchmark, so stb's implementation is compiled static here.
+// The canvas, the font and stb come from png_canvas.hpp.
 #pragma once
 
-#define STB_IMAGE_WRITE_STATIC
-#define STB_IMAGE_WRITE_IMPLEMENTATION
-#include <stb/stb_image_write.h>
+#include "support/png_canvas.hpp"
 
 #include <algorithm>
 #include <array>
@@ -25,45 +23,7 @@ struct Heatmap {
 
 namespace heatmap_detail {
 
-/// 3x5 glyphs, one row of 3 bits per line, top line first.
-inline const std::array<std::uint8_t, 5>* glyph(char c) {
-  static const std::array<std::uint8_t, 5> digits[10] = {
-      {7, 5, 5, 5, 7}, {2, 6, 2, 2, 7}, {7, 1, 7, 4, 7}, {7, 1, 7, 1, 7}, {5, 5, 7, 1, 1},
-      {7, 4, 7, 1, 7}, {7, 4, 7, 5, 7}, {7, 1, 1, 1, 1}, {7, 5, 7, 5, 7}, {7, 5, 7, 1, 7}};
-  static const std::array<std::uint8_t, 5> dot = {0, 0, 0, 0, 2}, minus = {0, 0, 7, 0, 0},
-                                           percent = {5, 1, 2, 4, 5};
-  if (c >= '0' && c <= '9') return &digits[c - '0'];
-  if (c == '.') return &dot;
-  if (c == '-') return &minus;
-  if (c == '%') return &percent;
-  return nullptr;
-}
-
-struct Canvas {
-  int width, height;
-  std::vector<std::uint8_t> rgb;
-  Canvas(int w, int h) : width(w), height(h), rgb(static_cast<std::size_t>(w) * h * 3, 255) {}
-  void rect(int x0, int y0, int x1, int y1, std::array<std::uint8_t, 3> c) {
-    for (int y = std::max(0, y0); y < std::min(height, y1); ++y)
-      for (int x = std::max(0, x0); x < std::min(width, x1); ++x)
-        for (int k = 0; k < 3; ++k) rgb[(static_cast<std::size_t>(y) * width + x) * 3 + k] = c[k];
-  }
-  /// Text centred on (cx, cy), `scale` pixels per font dot.
-  void text(int cx, int cy, const std::string& s, int scale) {
-    const int w = static_cast<int>(s.size()) * 4 * scale - scale;
-    int x = cx - w / 2;
-    const int y = cy - 5 * scale / 2;
-    for (char ch : s) {
-      if (const auto* g = glyph(ch))
-        for (int r = 0; r < 5; ++r)
-          for (int b = 0; b < 3; ++b)
-            if ((*g)[r] >> (2 - b) & 1)
-              rect(x + b * scale, y + r * scale, x + (b + 1) * scale, y + (r + 1) * scale,
-                   {0, 0, 0});
-      x += 4 * scale;
-    }
-  }
-};
+using png_canvas::Canvas;
 
 inline std::array<std::uint8_t, 3> colour(double percent) {
   if (percent < 0) return {200, 200, 200};
@@ -96,8 +56,7 @@ inline bool write_heatmap_png(const std::string& path, const Heatmap& map) {
   for (int c = 0; c < cols && c < static_cast<int>(map.column_labels.size()); ++c)
     canvas.text(kMargin + c * kCell + kCell / 2, rows * kCell + kMargin / 2, map.column_labels[c],
                 kScale - 1);
-  return stbi_write_png(path.c_str(), canvas.width, canvas.height, 3, canvas.rgb.data(),
-                        canvas.width * 3) != 0;
+  return canvas.write_png(path);
 }
 
 }  // namespace ulc_bench
