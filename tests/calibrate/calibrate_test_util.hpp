@@ -10,9 +10,23 @@
 #include <random>
 #include <vector>
 
+#include "ulc/calibrate.hpp"
 #include "ulc/core/lie.hpp"
+#include "ulc/core/point_cloud.hpp"
 #include "ulc/core/types.hpp"
 #include "ulc/sim/simulate.hpp"
+
+namespace calibrate_test {
+/// The simulator's frames, the type most of these tests calibrate.
+using SimFrames = std::vector<ulc::PointCloud<float>>;
+}  // namespace calibrate_test
+
+// The whole pipeline on the simulator's frames is compiled once, in calibrate_instantiation.cpp:
+// instantiated in every test file, it made each one take about 3 minutes to compile.
+extern template ulc::PairCalibration
+ulc::calibrate_pair<calibrate_test::SimFrames, calibrate_test::SimFrames>(
+    const calibrate_test::SimFrames&, const std::vector<double>&, const calibrate_test::SimFrames&,
+    const std::vector<double>&, const ulc::CalibrateOptions&);
 
 namespace calibrate_test {
 
