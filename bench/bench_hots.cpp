@@ -4,7 +4,10 @@
 //   bench_hots --accuracy    [--scenarios 64-32,...] [--seconds 60] [--runs 10]
 //   bench_hots --time-offset [--scenarios 64-32,64-horizon] [--seconds 60] [--runs 10]
 //                            [--spread-png PREFIX]
-//   common: [--decimation 1] [--threads 2] [--json]
+//   common: [--decimation 1] [--threads 2] [--deskew-from-base] [--json]
+//   --deskew-from-base: the whole-sequence step reads b's frames deskewed afresh with the
+//   base's refined trajectory (SequenceExtrinsicOptions::deskew_from_base) instead of b's own
+//   odometry.
 //
 // Each run simulates the drive with seed = run index + 1, disturbs the truth by 5 deg about a
 // random axis and 2 m in a random direction (seeded by the run), runs JEEP (calibrate_pair,
@@ -56,7 +59,8 @@ struct Config {
   std::size_t runs = 10;
   unsigned decimation = 1;
   int threads = 2;
-  std::string spread_png;  ///< prefix of the spread curve pictures; empty: none
+  std::string spread_png;         ///< prefix of the spread curve pictures; empty: none
+  bool deskew_from_base = false;  ///< --deskew-from-base
   ulc_bench::Options bench;
 };
 
@@ -120,6 +124,7 @@ Run one_run(const std::string& scenario, double offset_s, std::size_t run, const
     ulc::CalibrateOptions o;
     o.stages = {ulc::Stage::jeep};
     o.initial = initial;
+    o.hots.sequence.deskew_from_base = c.deskew_from_base;
     const auto j = ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, o);
     out.status = ulc::to_string(j.status);
     out.jeep_ok = j.success;
@@ -293,6 +298,8 @@ int main(int argc, char** argv) {
       c.threads = std::max(1, std::atoi(argv[++i]));
     } else if (a == "--spread-png" && value) {
       c.spread_png = argv[++i];
+    } else if (a == "--deskew-from-base") {
+      c.deskew_from_base = true;
     } else {
       rest.push_back(argv[i]);
     }

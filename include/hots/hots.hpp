@@ -137,20 +137,19 @@ inline double lap(std::chrono::steady_clock::time_point& start) {
   return s;
 }
 
-/// Deskewed (constant velocity from the poses) and downsampled copies of the frames.
-template <typename S, class Frames>
-std::vector<std::vector<ulc::Vec3<S>>> prepare_frames(const Frames& frames,
-                                                      const std::vector<double>& times,
-                                                      const std::vector<Isometry3d>& poses,
-                                                      double voxel) {
+/// Deskewed and downsampled copies of every stride-th frame (the others stay empty);
+/// sweep(k) gives frame k's motion over its sweep and the sweep's duration.
+template <typename S, class Frames, class Sweep>
+std::vector<std::vector<ulc::Vec3<S>>> prepare_frames(const Frames& frames, const Sweep& sweep,
+                                                      double voxel, std::size_t stride = 1) {
   std::vector<std::vector<ulc::Vec3<S>>> out(frames.size());
+  stride = std::max<std::size_t>(stride, 1);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, frames.size(), 1),
                     [&](const tbb::blocked_range<std::size_t>& r) {
                       for (std::size_t k = r.begin(); k != r.end(); ++k) {
-                        const std::size_t j = k + 1 < frames.size() ? k : k - 1;
-                        const double duration = times[j + 1] - times[j];
-                        const Isometry3d motion = poses[j].inverse() * poses[j + 1];
-                        const auto deskewed = ulc::deskew(frames[k], motion, duration);
+                        if (k % stride != 0) continue;
+                        const std::pair<Isometry3d, double> motion = sweep(k);
+                        const auto deskewed = ulc::deskew(frames[k], motion.first, motion.second);
                         const auto down = ulc::voxel_downsample(deskewed, voxel);
                         const auto& pts = down.ok() ? down.cloud.points : deskewed.points;
                         out[k].reserve(pts.size());
@@ -158,6 +157,38 @@ std::vector<std::vector<ulc::Vec3<S>>> prepare_frames(const Frames& frames,
                       }
                     });
   return out;
+}
+
+/// Constant velocity from a LiDAR's own poses: the motion to the next frame.
+inline std::pair<Isometry3d, double> own_sweep(const std::vector<double>& times,
+                                               const std::vector<Isometry3d>& poses,
+                                               std::size_t k) {
+  const std::size_t j = k + 1 < times.size() ? k : k - 1;
+  return {poses[j].inverse() * poses[j + 1], times[j + 1] - times[j]};
+}
+
+/// Every frame deskewed with its LiDAR's own poses (own_sweep).
+template <typename S, class Frames>
+std::vector<std::vector<ulc::Vec3<S>>> prepare_frames(const Frames& frames,
+                                                      const std::vector<double>& times,
+                                                      const std::vector<Isometry3d>& poses,
+                                                      double voxel) {
+  return prepare_frames<S>(
+      frames, [&](std::size_t k) { return own_sweep(times, poses, k); }, voxel);
+}
+
+/// b's sweep from the base's trajectory T_world_a through C at b's instant t_b + dt:
+/// C^-1 T_a(t)^-1 T_a(t + D) C with D b's frame period.
+inline std::pair<Isometry3d, double> base_sweep(const std::vector<double>& times_b,
+                                                const std::vector<double>& times_a,
+                                                const std::vector<Isometry3d>& world_a,
+                                                const Isometry3d& C, double dt, std::size_t k) {
+  const std::size_t j = k + 1 < times_b.size() ? k : k - 1;
+  const double duration = times_b[j + 1] - times_b[j];
+  const double t = times_b[k] + dt;
+  const Isometry3d motion = time_sync_detail::pose_at(times_a, world_a, t).inverse() *
+                            time_sync_detail::pose_at(times_a, world_a, t + duration);
+  return {C.inverse() * motion * C, duration};
 }
 
 /// The a frame nearest to t (a's clock) and a's motion from it to t (interpolated or
@@ -339,8 +370,17 @@ RefineResult refine(const FramesA& frames_a, const std::vector<double>& times_a,
     SequenceExtrinsicOptions so = options.sequence;
     so.estimate_time_offset = so.estimate_time_offset && st.sync_significant;
     const auto t0 = std::chrono::steady_clock::now();
-    st.sequence = sequence_extrinsic(ha, fa, times_a, wa, fb, times_b, result.extrinsic,
-                                     result.time_offset_s, so);
+    // b's frames deskewed afresh through the base's refined motion (deskew_from_base).
+    std::vector<std::vector<ulc::Vec3<S>>> fb_base;
+    if (so.deskew_from_base)
+      fb_base = d::prepare_frames<S>(
+          frames_b,
+          [&](std::size_t k) {
+            return d::base_sweep(times_b, times_a, wa, result.extrinsic, result.time_offset_s, k);
+          },
+          options.frame_voxel, so.frame_stride);
+    st.sequence = sequence_extrinsic(ha, fa, times_a, wa, so.deskew_from_base ? fb_base : fb,
+                                     times_b, result.extrinsic, result.time_offset_s, so);
     st.sequence_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (!st.sequence.ok()) return fail(RefineStatus::sequence_failed, st.sequence.reason);

@@ -76,3 +76,29 @@ TEST_CASE("refine reports unusable input", "[hots][refine]") {
                      ulc::Isometry3d::Identity())
             .status == hots::RefineStatus::invalid_input);
 }
+
+TEST_CASE("b's sweep taken from the base's trajectory through the extrinsic", "[hots][deskew]") {
+  // The base moves with a constant body twist; b's sweep over [t, t + D] is then
+  // C^-1 exp(D xi) C, and it does not depend on where along the trajectory it starts.
+  const ulc::Vec6d xi = (ulc::Vec6d() << 8.0, 0.3, 0.0, 0.0, 0.02, 0.35).finished();
+  std::vector<double> times_a;
+  std::vector<ulc::Isometry3d> world_a;
+  for (int k = 0; k < 20; ++k) {
+    times_a.push_back(0.1 * k);
+    world_a.push_back(ulc::se3_exp(ulc::Vec6d(times_a.back() * xi)));
+  }
+  std::mt19937_64 rng(3);
+  const ulc::Isometry3d C =
+      jeep_test::disturbed(ulc::Isometry3d::Identity(), rng, 40.0 * hots_test::kDeg, 1.5);
+  const std::vector<double> times_b{0.02, 0.12, 0.22, 0.32};
+  const double dt = 0.037;
+  for (std::size_t k = 0; k < times_b.size(); ++k) {
+    const auto sweep = hots::hots_detail::base_sweep(times_b, times_a, world_a, C, dt, k);
+    CHECK(sweep.second == Approx(0.1));
+    const ulc::Isometry3d expected = C.inverse() * ulc::se3_exp(ulc::Vec6d(0.1 * xi)) * C;
+    // Linear interpolation between 10 Hz poses: exact for the rotation, a bending of the
+    // translation by at most the arc's sagitta |v| |w| T^2 / 8 at each end (here 3.5 mm).
+    CHECK((sweep.first.translation() - expected.translation()).norm() < 7e-3);
+    CHECK(ulc::so3_log(sweep.first.linear() * expected.linear().transpose()).norm() < 1e-9);
+  }
+}
