@@ -7,7 +7,8 @@
 //   bench_jeep --robustness [--scenarios 64-32,64-horizon] [--starts 3] [--png DIR]
 //   bench_jeep --frames-sweep [--scenarios 64-32,64-horizon,64-tele] [--starts 5] [--png DIR]
 //   bench_jeep --odometry   [--seconds 20] [--repeats 1]
-//   common: [--seconds 20] [--seed 1] [--threads 2] [--cache DIR] [--json]
+//   common: [--seconds 20] [--seed 1] [--threads 2] [--cache DIR] [--one-way] [--json]
+//   --one-way: JEEP without its two-way step (jeep/two_way.hpp), the earlier behaviour.
 //
 // (a) accuracy, the paper's protocol: the ground truth disturbed by 5 deg about a random axis
 //     and 2 m in a random direction (seeded per start), at --starts windows spread evenly along
@@ -63,9 +64,18 @@ struct Config {
   std::uint64_t seed = 1;
   int threads = 2;
   std::string cache = "/tmp/ulc_jeep_cache";
-  std::string png_dir;  ///< --png DIR: robustness and frames-sweep heat maps as PNG
+  std::string png_dir;   ///< --png DIR: robustness and frames-sweep heat maps as PNG
+  bool one_way = false;  ///< --one-way: JEEP without the two-way step
   ulc_bench::Options bench;
 };
+
+/// JEEP's options for K frame pairs, as the command line asks.
+jeep::JeepOptions jeep_options(const Config& c, std::size_t frames) {
+  jeep::JeepOptions o;
+  o.frames = frames;
+  o.two_way = !c.one_way;
+  return o;
+}
 
 template <class F>
 auto in_arena(int threads, F&& f) {
@@ -237,8 +247,7 @@ void accuracy(Config c) {
   ulc_bench::Table table({"scenario", "method", "runs", "success_pct", "accepted_pct",
                           "false_accepts", "median_e_rot_deg", "median_e_trans_cm", "p90_e_rot_deg",
                           "p90_e_trans_cm", "median_rounds", "median_time_s"});
-  jeep::JeepOptions o;
-  o.frames = c.frames;
+  const jeep::JeepOptions o = jeep_options(c, c.frames);
   for (const auto& scenario : c.scenarios) {
     const Drive d = load_drive(scenario, c);
     Summary jeep_summary, scan_summary;
@@ -291,8 +300,7 @@ void separation(Config c) {
   if (!c.starts) c.starts = 10;
   ulc_bench::Table table({"scenario", "data", "runs", "accepted_pct", "overlap_min",
                           "overlap_median", "overlap_max", "condition_min", "condition_median"});
-  jeep::JeepOptions o;
-  o.frames = c.frames;
+  const jeep::JeepOptions o = jeep_options(c, c.frames);
   for (const auto& scenario : c.scenarios) {
     const Drive d = load_drive(scenario, c);
     const std::size_t half = d.pairs.size() / 2;
@@ -360,8 +368,7 @@ void robustness(Config c) {
   if (!c.starts) c.starts = 3;
   ulc_bench::Table table({"scenario", "rot_deg", "trans_m", "runs", "success_pct",
                           "median_e_rot_deg", "median_e_trans_cm"});
-  jeep::JeepOptions o;
-  o.frames = c.frames;
+  const jeep::JeepOptions o = jeep_options(c, c.frames);
   for (const auto& scenario : c.scenarios) {
     const Drive d = load_drive(scenario, c);
     ulc_bench::Heatmap map;  // rows: rotation disturbance, columns: translation disturbance
@@ -406,8 +413,7 @@ void frames_sweep(Config c) {
     map.row_labels.push_back(std::to_string(map.row_labels.size() + 1));
     map.values.emplace_back();
     for (std::size_t K = 2; K <= 12; ++K) {
-      jeep::JeepOptions o;
-      o.frames = K;
+      const jeep::JeepOptions o = jeep_options(c, K);
       Summary sum;
       for (std::size_t s : start_pairs(d, c.starts, 12))
         sum.add(
@@ -608,6 +614,8 @@ int main(int argc, char** argv) {
       c.cache = argv[++i];
     } else if (a == "--png" && value) {
       c.png_dir = argv[++i];
+    } else if (a == "--one-way") {
+      c.one_way = true;
     } else {
       rest.push_back(argv[i]);
     }

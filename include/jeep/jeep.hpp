@@ -34,6 +34,7 @@
 #include "jeep/odometry.hpp"
 #include "jeep/run_odometry.hpp"
 #include "jeep/scan_preparation.hpp"
+#include "jeep/two_way.hpp"
 #include "ulc/core/lie.hpp"
 #include "ulc/core/point_traits.hpp"
 #include "ulc/core/types.hpp"
@@ -54,6 +55,9 @@ struct JeepOptions {
   AcceptanceOptions acceptance;
   /// Frame period when the timestamps cannot tell (a single frame): DESIGN.md's 10 Hz.
   double default_period = 0.1;
+  /// Once settled, meet map a registered to map b's planes halfway (two_way.hpp), so that
+  /// swapping base and target gives the inverse extrinsic.
+  bool two_way = true;
 };
 
 enum class JeepStatus {
@@ -104,6 +108,7 @@ struct JeepResult {
   int rounds = 0;
   RegistrationResult<double> calibration;  ///< the last calibration phase
   AcceptanceReport acceptance;
+  TwoWayResult two_way;  ///< the last step when JeepOptions::two_way (applied: it was used)
   std::vector<JeepRound> trace;
   /// The last round's maps (eq:build_map) at calibration.target_voxel, in the frames of
   /// poses_a and poses_b: where they overlap, map_a = C * map_b.
@@ -264,6 +269,11 @@ JeepResult run_jeep(const FramesA& frames_a, const std::vector<double>& times_a,
       settled = trace.change_translation < options.settle_translation &&
                 trace.change_rotation < options.settle_rotation;
     previous_poses = poses_a;
+    if (settled && options.two_way) {
+      result.two_way = two_way_extrinsic(map_a, map_b, C, stages);
+      C = result.two_way.extrinsic;
+      result.extrinsic = C;
+    }
     if (settled || round == options.max_rounds) {
       result.acceptance = assess(map_a, map_b, target, options.calibration, C, options.acceptance);
       // In the output poses' frames (see to_first below).

@@ -155,8 +155,8 @@ TEST_CASE("real sample: croon_0003 calibrates top<-left and left<-top, and they 
                               << cycle.rotation_deg << " deg, " << cycle.translation_m << " m");
   CHECK(ulc::is_calibration_success(e_forward));  // CROON itself is good to ~0.2 deg, 5 cm
   CHECK(ulc::is_calibration_success(e_swapped));
-  // Issue 7 asks for 0.02 deg and 5 mm; measured (2026-11-22): 0.092 deg and 28 mm, the two
-  // single-frame results differing by about CROON's own accuracy. Bound: 1.5x the measurement.
-  CHECK(cycle.rotation_deg < 0.14);
-  CHECK(cycle.translation_m < 0.043);
+  // Issue 7's bar. One-way registration left 0.092 deg and 28 mm here (each direction fits its
+  // own target's points); JEEP's two-way step (two_way.hpp) meets the directions halfway.
+  CHECK(cycle.rotation_deg < 0.02);
+  CHECK(cycle.translation_m < 0.005);
 }

@@ -93,6 +93,10 @@ struct JeepReport {
   double final_rmse = 0.0;         ///< m
   bool accepted = false;           ///< the acceptance rule's verdict
   double overlap = 0.0;            ///< acceptance: agreeing / near map points
+  /// Two-way step (jeep/two_way.hpp): applied, and how far the two directions disagreed.
+  bool two_way = false;
+  double two_way_gap_translation = 0.0;  ///< m
+  double two_way_gap_rotation = 0.0;     ///< rad
   double seconds = 0.0;
 };
 
