@@ -57,6 +57,17 @@ inline ulc::sim::Dataset simulate(const DriveSpec& d) {
   return out;
 }
 
+/// 0.1 s of the 64-32 rig parked (the vehicle stands still from the start), every second
+/// point: single frames that need no deskewing.
+inline ulc::sim::Dataset parked_64_32() {
+  ulc::sim::SimulationOptions o;
+  o.seconds = 0.1;
+  o.seed = 4;
+  o.decimation = 2;
+  o.static_at_s = 5.0;
+  return ulc::sim::simulate(*ulc::sim::scenario("64-32"), o).dataset;
+}
+
 namespace detail {
 
 template <typename T>

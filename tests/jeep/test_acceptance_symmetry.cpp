@@ -24,14 +24,7 @@ namespace {
 /// One frame of each LiDAR of the parked 64-32 rig (no motion, so the frames are the maps): a
 /// 64-beam map and a sparser 32-beam one.
 const ulc::sim::Dataset& rig_64_32() {
-  static const ulc::sim::Dataset d = [] {
-    ulc::sim::SimulationOptions o;
-    o.seconds = 0.1;
-    o.seed = 4;
-    o.decimation = 2;
-    o.static_at_s = 5.0;
-    return ulc::sim::simulate(*ulc::sim::scenario("64-32"), o).dataset;
-  }();
+  static const ulc::sim::Dataset d = parked_64_32();
   return d;
 }
 

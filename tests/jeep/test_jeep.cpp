@@ -137,14 +137,7 @@ TEST_CASE("JEEP reports bad input and unsettled rounds", "[jeep]") {
 
 TEST_CASE("scan-scan recovers the mounting of a parked rig from a small disturbance",
           "[jeep][scan_scan]") {
-  DriveSpec spec = town_drive();
-  spec.seconds = 0.1;
-  ulc::sim::SimulationOptions o;
-  o.seconds = 0.1;
-  o.seed = 4;
-  o.decimation = 2;
-  o.static_at_s = 5.0;
-  const auto parked = ulc::sim::simulate(*ulc::sim::scenario("64-32"), o).dataset;
+  const auto parked = parked_64_32();
   const Isometry3d truth = parked.pairs[0].T_base_target;
   std::mt19937_64 rng(5);
   const Isometry3d initial = disturbed(truth, rng, 2.0 * kDeg, 0.3);

@@ -33,12 +33,7 @@ struct ParkedRig {
 };
 
 ParkedRig parked_rig() {
-  ulc::sim::SimulationOptions o;
-  o.seconds = 0.1;
-  o.seed = 4;
-  o.decimation = 2;
-  o.static_at_s = 5.0;
-  const auto d = ulc::sim::simulate(*ulc::sim::scenario("64-32"), o).dataset;
+  const auto d = parked_64_32();
   ParkedRig r;
   r.a = {d.lidars.at(0).frames.at(0)};
   r.b = {d.lidars.at(1).frames.at(0)};
