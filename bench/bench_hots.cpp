@@ -4,17 +4,17 @@
 //   bench_hots --accuracy    [--scenarios 64-32,...] [--seconds 60] [--runs 10]
 //   bench_hots --time-offset [--scenarios 64-32,64-horizon] [--seconds 60] [--runs 10]
 //                            [--spread-png PREFIX]
-//   common: [--decimation 1] [--threads 2] [--deskew-from-base] [--json]
+//   common: [--decimation 1] [--threads 2] [--deskew-from-base] [--first-run 0] [--json]
 //   --deskew-from-base: the whole-sequence step reads b's frames deskewed afresh with the
 //   base's refined trajectory (SequenceExtrinsicOptions::deskew_from_base) instead of b's own
 //   odometry.
 //
-// Each run simulates the drive with seed = run index + 1, disturbs the truth by 5 deg about a
-// random axis and 2 m in a random direction (seeded by the run), runs JEEP (calibrate_pair,
-// stages jeep, K = 5 pairs from the first frame), then the pipeline's HOTS stage by hand (the
-// same odometry and refine options as ulc::CalibrateOptions' defaults) so that the poses are at
-// hand for the trajectory error. Success: HOTS ok and e_rot < 1 deg and e_trans < 10 cm.
-// Medians are over all runs, failures included. --time-offset runs each scenario with the
+// Each run simulates the drive with seed = run index + 1 (runs --first-run onwards), disturbs the
+// truth by 5 deg about a random axis and 2 m in a random direction (seeded by the run), runs JEEP
+// (calibrate_pair, stages jeep, K = 5 pairs from the first frame), then the pipeline's HOTS stage
+// by hand (the same odometry and refine options as ulc::CalibrateOptions' defaults) so that the
+// poses are at hand for the trajectory error. Success: HOTS ok and e_rot < 1 deg and e_trans < 10
+// cm. Medians are over all runs, failures included. --time-offset runs each scenario with the
 // target's clock 50 ms behind (the paper's figure) and with no offset. --spread-png PREFIX
 // writes run 0's spread-against-offset curve (HOTS's last time synchronisation pass) of each
 // scenario and offset to PREFIX_<scenario>_<offset_ms>ms.png: x the candidate offset in ms,
@@ -57,10 +57,13 @@ struct Config {
   std::vector<std::string> scenarios;
   double seconds = 60.0;
   std::size_t runs = 10;
+  std::size_t first_run = 0;  ///< --first-run: runs first_run .. first_run + runs - 1
   unsigned decimation = 1;
   int threads = 2;
   std::string spread_png;         ///< prefix of the spread curve pictures; empty: none
   bool deskew_from_base = false;  ///< --deskew-from-base
+  double pre_shift_s = 0.0;       ///< --pre-shift-ms
+  bool no_traffic = false;        ///< --no-traffic: the scenario without its oncoming cars
   ulc_bench::Options bench;
 };
 
@@ -106,6 +109,7 @@ Run one_run(const std::string& scenario, double offset_s, std::size_t run, const
   Run out;
   auto spec = *ulc::sim::scenario(scenario);
   if (offset_s != 0.0) ulc::sim::set_clock_offset(spec, spec.pairs.at(0).target, offset_s);
+  if (c.no_traffic) spec.traffic_per_km = 0.0;
   ulc::sim::SimulationOptions so;
   so.seconds = c.seconds;
   so.seed = run + 1;
@@ -113,8 +117,12 @@ Run one_run(const std::string& scenario, double offset_s, std::size_t run, const
   const ulc::sim::Dataset d = ulc::sim::simulate(spec, so).dataset;
   const auto& a = d.lidars.at(0);
   const auto& b = d.lidars.at(1);
+  // --pre-shift-ms: b's timestamps moved by that much before every stage (an experiment: how the
+  // offset's estimate depends on what the stages before HOTS assume).
+  std::vector<double> times_b = b.timestamps;
+  for (double& t : times_b) t += c.pre_shift_s;
   const Isometry3d truth = d.pairs.at(0).T_base_target;
-  const double true_offset = d.pairs.at(0).time_offset_s;
+  const double true_offset = d.pairs.at(0).time_offset_s - c.pre_shift_s;
   out.true_offset_s = true_offset;
   std::mt19937_64 rng(1000003ULL * (run + 1));
   const Isometry3d initial = jeep_test::disturbed(truth, rng, 5.0 * kDeg, 2.0);
@@ -125,7 +133,7 @@ Run one_run(const std::string& scenario, double offset_s, std::size_t run, const
     o.stages = {ulc::Stage::jeep};
     o.initial = initial;
     o.hots.sequence.deskew_from_base = c.deskew_from_base;
-    const auto j = ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, o);
+    const auto j = ulc::calibrate_pair(a.frames, a.timestamps, b.frames, times_b, o);
     out.status = ulc::to_string(j.status);
     out.jeep_ok = j.success;
     const Isometry3d C = j.jeep ? j.jeep->extrinsic : initial;
@@ -134,8 +142,7 @@ Run one_run(const std::string& scenario, double offset_s, std::size_t run, const
     out.dt_error_s = out.sync_dt_error_s = true_offset;
     if (!j.success) return;
     auto t0 = std::chrono::steady_clock::now();
-    const auto odo =
-        jeep::run_odometry(a.frames, a.timestamps, b.frames, b.timestamps, C, o.odometry);
+    const auto odo = jeep::run_odometry(a.frames, a.timestamps, b.frames, times_b, C, o.odometry);
     out.odometry_s = seconds_since(t0);
     if (!ulc::calibrate_detail::odometry_usable(odo)) {
       out.status = std::string("odometry_") + jeep::to_string(odo.status);
@@ -143,11 +150,12 @@ Run one_run(const std::string& scenario, double offset_s, std::size_t run, const
     }
     out.ate_odometry = ate(d, 0, odo.poses_a);
     t0 = std::chrono::steady_clock::now();
-    const auto h = hots::refine(a.frames, a.timestamps, odo.poses_a, b.frames, b.timestamps,
-                                odo.poses_b, C, o.hots);
+    const auto h = hots::refine(a.frames, a.timestamps, odo.poses_a, b.frames, times_b, odo.poses_b,
+                                C, o.hots);
     out.hots_s = seconds_since(t0);
     out.status = std::string("hots_") + hots::to_string(h.status);
     out.hots_ok = h.ok();
+    out.sequence = h.statistics.sequence;  // the trust check's figures, whatever the status
     if (!h.ok()) return;
     out.hots_error = ulc::pose_error(truth, h.extrinsic);
     out.dt_error_s = h.time_offset_s - true_offset;
@@ -202,7 +210,8 @@ void bench(Config c) {
   ulc_bench::Table table({"scenario", "offset_ms", "runs", "jeep_success_pct", "hots_success_pct",
                           "jeep_e_rot_deg", "sync_e_rot_deg", "hots_e_rot_deg", "jeep_e_trans_cm",
                           "sync_e_trans_cm", "hots_e_trans_cm", "sync_dt_error_ms", "dt_error_ms",
-                          "ate_odometry_cm", "ate_hots_cm", "odometry_s", "hots_s"});
+                          "ate_odometry_cm", "ate_hots_cm", "offset_untrusted", "odometry_s",
+                          "hots_s"});
   for (const auto& scenario : c.scenarios) {
     if (!ulc::sim::scenario(scenario)) {
       std::cerr << "bench_hots: unknown scenario '" << scenario << "'\n";
@@ -210,13 +219,14 @@ void bench(Config c) {
     }
     for (const double offset : offset_list) {
       std::vector<double> jr, hr, jt, ht, dt, ao, ah, so, sh, yr, yt, ydt;
-      std::size_t jeep_ok = 0, hots_ok = 0;
-      for (std::size_t run = 0; run < c.runs; ++run) {
+      std::size_t jeep_ok = 0, hots_ok = 0, untrusted = 0;
+      for (std::size_t run = c.first_run; run < c.first_run + c.runs; ++run) {
         const Run r = one_run(scenario, offset, run, c);
         const bool j_success = r.jeep_ok && ulc::is_calibration_success(r.jeep_error);
         const bool h_success = r.hots_ok && ulc::is_calibration_success(r.hots_error);
         jeep_ok += j_success ? 1 : 0;
         hots_ok += h_success ? 1 : 0;
+        untrusted += r.sequence.time_offset_checked && !r.sequence.time_offset_trusted ? 1 : 0;
         jr.push_back(r.jeep_error.rotation_deg);
         hr.push_back(r.hots_error.rotation_deg);
         jt.push_back(r.jeep_error.translation_m);
@@ -239,11 +249,16 @@ void bench(Config c) {
                     << r.dt_error_s * 1e3 << " ms, ATE " << r.ate_odometry * 100 << " -> "
                     << r.ate_hots * 100 << " cm (" << r.odometry_s << " + " << r.hots_s
                     << " s); sequence: joint dt " << r.sequence.joint_time_offset_s * 1e3
-                    << " ms sigma " << r.sequence.time_sigma_s * 1e3 << " ms adopted "
-                    << r.sequence.time_offset_refined << ", " << r.sequence.iterations
-                    << " matchings, " << r.sequence.source_points << " points, " << r.sequence_s
-                    << " s\n";
-        if (offsets && run == 0 && !c.spread_png.empty()) write_spread_png(r, scenario, offset, c);
+                    << " ms sigma " << r.sequence.time_sigma_s * 1e3 << " ms observability "
+                    << r.sequence.time_observability << " adopted "
+                    << r.sequence.time_offset_refined << " halves "
+                    << r.sequence.half_time_offset_s[0] * 1e3 << ", "
+                    << r.sequence.half_time_offset_s[1] * 1e3 << " ms trusted "
+                    << r.sequence.time_offset_trusted << " (" << r.sequence.time_offset_doubt
+                    << "), " << r.sequence.iterations << " matchings, " << r.sequence.source_points
+                    << " points, " << r.sequence_s << " s\n";
+        if (offsets && run == c.first_run && !c.spread_png.empty())
+          write_spread_png(r, scenario, offset, c);
       }
       const double n = static_cast<double>(c.runs);
       using jeep_test::median;
@@ -254,7 +269,8 @@ void bench(Config c) {
            Cell::num(median(yr), 4), Cell::num(median(hr), 4), Cell::num(100 * median(jt), 2),
            Cell::num(100 * median(yt), 2), Cell::num(100 * median(ht), 2),
            Cell::num(1e3 * median(ydt), 2), Cell::num(1e3 * median(dt), 2),
-           Cell::num(100 * median(ao), 2), Cell::num(100 * median(ah), 2), Cell::num(median(so), 2),
+           Cell::num(100 * median(ao), 2), Cell::num(100 * median(ah), 2),
+           Cell::integer(static_cast<long long>(untrusted)), Cell::num(median(so), 2),
            Cell::num(median(sh), 2)});
     }
   }
@@ -264,12 +280,15 @@ void bench(Config c) {
        {{"scenarios", list},
         {"seconds", Cell::num(c.seconds, 1)},
         {"runs", Cell::integer(static_cast<long long>(c.runs))},
+        {"first_run", Cell::integer(static_cast<long long>(c.first_run))},
         {"decimation", Cell::integer(c.decimation)},
         {"threads", Cell::integer(c.threads)},
         {"disturbance", "5 deg about a random axis, 2 m in a random direction, before JEEP"}},
        {{"success", "status ok and e_rot < 1 deg and e_trans < 10 cm"},
         {"medians", "over all runs, failures included (a failed HOTS counts JEEP's error)"},
         {"dt_error", "|estimated - true clock offset|; the true offset when HOTS did not run"},
+        {"offset_untrusted",
+         "runs whose HOTS refused its clock offset (time_offset_untrusted: a failure above)"},
         {"sync",
          "the time synchronisation's answer (spread minimum, eq:mean), before the "
          "whole-sequence step that gives HOTS's final extrinsic and offset"},
@@ -292,12 +311,18 @@ int main(int argc, char** argv) {
       c.seconds = std::atof(argv[++i]);
     } else if (a == "--runs" && value) {
       c.runs = std::max<std::size_t>(1, std::strtoul(argv[++i], nullptr, 10));
+    } else if (a == "--first-run" && value) {
+      c.first_run = std::strtoul(argv[++i], nullptr, 10);
     } else if (a == "--decimation" && value) {
       c.decimation = static_cast<unsigned>(std::max(1, std::atoi(argv[++i])));
     } else if (a == "--threads" && value) {
       c.threads = std::max(1, std::atoi(argv[++i]));
     } else if (a == "--spread-png" && value) {
       c.spread_png = argv[++i];
+    } else if (a == "--pre-shift-ms" && value) {
+      c.pre_shift_s = std::atof(argv[++i]) * 1e-3;
+    } else if (a == "--no-traffic") {
+      c.no_traffic = true;
     } else if (a == "--deskew-from-base") {
       c.deskew_from_base = true;
     } else {
@@ -307,7 +332,7 @@ int main(int argc, char** argv) {
   c.bench = ulc_bench::parse_options(static_cast<int>(rest.size()), rest.data(),
                                      "HOTS after JEEP on simulated drives (modes: --accuracy "
                                      "--time-offset; options --scenarios --seconds --runs "
-                                     "--decimation --threads --spread-png)");
+                                     "--first-run --decimation --threads --spread-png)");
   bench(c);
   return 0;
 }

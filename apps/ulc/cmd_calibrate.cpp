@@ -153,6 +153,9 @@ int run_calibrate(int argc, char** argv) {
       .option("frame-index", "N", "TERRA's frame, and the first frame of JEEP and HOTS (default 0)")
       .option("frames", "K", "frame pairs JEEP uses (default 5)")
       .option("threads", "N", "worker threads (default: all cores)")
+      .flag("synced-clocks",
+            "the LiDARs' clocks are synchronised (PTP, GPS): HOTS estimates no clock offset "
+            "(for short drives that cannot pin one down)")
       .flag("no-route",
             "do not calibrate a failed target through another target that did calibrate")
       .flag("no-cycles", "do not check the cycles base -> i -> j -> base (two targets or more)")
@@ -188,6 +191,7 @@ int run_calibrate(int argc, char** argv) {
     throw cli::UsageError("calibrate: --stages " + stages_to_string(options.stages) +
                           " needs an initial extrinsic: --initial \"x y z roll pitch yaw\" or "
                           "--initial FILE.json");
+  if (args.has("synced-clocks")) options.time_offset_s = 0.0;
   const auto frame_index =
       static_cast<std::size_t>(args.get_int("frame-index", 0, 0, 1000000000LL));
   options.jeep.frames = static_cast<std::size_t>(

@@ -34,6 +34,11 @@
 //     the per-pair extrinsics ([rho; phi], left); without synchronisation, the graph's marginal
 //     covariance of C.
 //   - refined poses are returned in the input map frames (b's through T_mapa_mapb).
+//   - With time synchronisation on, the whole-sequence step checks that the drive pins the
+//     clock offset down (sequence_extrinsic.hpp, check_time_offset); when it does not, the
+//     status is time_offset_untrusted and reason says why: the extrinsic absorbs v * (the
+//     offset's error), so the result cannot be trusted. A caller who knows the offset turns
+//     the synchronisation off and passes it as time_offset_s.
 //   - Nothing here throws or prints; results are the same for any number of threads.
 #pragma once
 
@@ -78,7 +83,14 @@ struct RefineOptions {
   SequenceExtrinsicOptions sequence;
 };
 
-enum class RefineStatus { ok, invalid_input, graph_failed, time_sync_failed, sequence_failed };
+enum class RefineStatus {
+  ok,
+  invalid_input,
+  graph_failed,
+  time_sync_failed,
+  sequence_failed,
+  time_offset_untrusted  ///< the drive does not pin the clock offset down (see reason)
+};
 
 inline const char* to_string(RefineStatus s) {
   switch (s) {
@@ -90,6 +102,8 @@ inline const char* to_string(RefineStatus s) {
       return "graph_failed";
     case RefineStatus::sequence_failed:
       return "sequence_failed";
+    case RefineStatus::time_offset_untrusted:
+      return "time_offset_untrusted";
     default:
       return "time_sync_failed";
   }
@@ -369,6 +383,8 @@ RefineResult refine(const FramesA& frames_a, const std::vector<double>& times_a,
     // significance test is what keeps a synchronised rig at exactly zero.
     SequenceExtrinsicOptions so = options.sequence;
     so.estimate_time_offset = so.estimate_time_offset && st.sync_significant;
+    // Without synchronisation the offset is the caller's (known clocks): nothing to check.
+    so.check_time_offset = so.check_time_offset && options.synchronise_time;
     const auto t0 = std::chrono::steady_clock::now();
     // b's frames deskewed afresh through the base's refined motion (deskew_from_base).
     std::vector<std::vector<ulc::Vec3<S>>> fb_base;
@@ -391,6 +407,8 @@ RefineResult refine(const FramesA& frames_a, const std::vector<double>& times_a,
   const Isometry3d mapb_mapa = mapa_mapb.inverse();
   for (std::size_t i = 0; i < na; ++i) result.poses_a[i] = graph.variables[i];
   for (std::size_t j = 0; j < nb; ++j) result.poses_b[j] = mapb_mapa * graph.variables[na + j];
+  if (!st.sequence.time_offset_trusted)
+    return fail(RefineStatus::time_offset_untrusted, st.sequence.time_offset_doubt);
   return result;
 }
 

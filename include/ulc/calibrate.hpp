@@ -29,7 +29,10 @@
 //     the report counts them); an odometry that gives no poses, or a HOTS that fails, ends the
 //     call with hots_failed, keeping the previous extrinsic. With fewer than
 //     hots_min_frames frames per LiDAR (single frames, as in a static rig's snapshot) HOTS is
-//     skipped after TERRA or JEEP: stages.hots has status "skipped" and the reason.
+//     skipped after TERRA or JEEP: stages.hots has status "skipped" and the reason. A HOTS
+//     whose clock offset the drive does not pin down fails too (time_offset_untrusted: the
+//     extrinsic would carry the offset's error times the speed); a caller who knows the
+//     clocks' offset sets time_offset_s, and then no offset is estimated or checked.
 //   - Progress: options.progress(stage, fraction in [0, 1]) on the calling thread; stages
 //     "terra", "jeep", "odometry", "hots" (HOTS reports only 0 and 1).
 //   - Threads: every stage is deterministic for any thread count, so is this. Run inside a
@@ -38,6 +41,7 @@
 #pragma once
 
 #include <chrono>
+#include <cmath>
 #include <cstddef>
 #include <functional>
 #include <optional>
@@ -101,7 +105,11 @@ struct CalibrateOptions {
   std::size_t hots_min_frames = 10;
   std::size_t frame_index = 0;        ///< TERRA's frame, and the first frame of the others
   std::optional<Isometry3d> initial;  ///< T_base_target guess, used when terra does not run
-  CalibrateProgress progress;         ///< optional
+  /// The clocks' offset when it is known (t_base = t_target + offset; 0 for synchronised
+  /// clocks): every stage reads b's timestamps moved onto a's clock, HOTS does not estimate an
+  /// offset (nor check one) and the result reports this one. Unset: HOTS estimates it.
+  std::optional<double> time_offset_s;
+  CalibrateProgress progress;  ///< optional
 };
 
 namespace calibrate_detail {
@@ -279,7 +287,7 @@ inline bool odometry_usable(const jeep::OdometryResult& odo) {
 /// Calibrates target LiDAR b against base LiDAR a (see the conventions at the top).
 template <class FramesA, class FramesB>
 PairCalibration calibrate_pair(const FramesA& frames_a, const std::vector<double>& times_a,
-                               const FramesB& frames_b, const std::vector<double>& times_b,
+                               const FramesB& frames_b, const std::vector<double>& times_b_own,
                                const CalibrateOptions& options = {}) {
   using calibrate_detail::seconds_since;
   const auto start = std::chrono::steady_clock::now();
@@ -302,8 +310,22 @@ PairCalibration calibrate_pair(const FramesA& frames_a, const std::vector<double
     if (!stage_available(s))
       return finish(CalibrateStatus::stage_not_available,
                     std::string("stage '") + to_string(s) + "' is not available yet");
-  if (frames_a.size() != times_a.size() || frames_b.size() != times_b.size())
+  if (frames_a.size() != times_a.size() || frames_b.size() != times_b_own.size())
     return finish(CalibrateStatus::invalid_input, "frame and timestamp counts differ");
+  if (options.time_offset_s && !std::isfinite(*options.time_offset_s))
+    return finish(CalibrateStatus::invalid_input, "the known time offset is not finite");
+  // A known clock offset: b's timestamps on a's clock, once, for every stage.
+  std::vector<double> times_b_on_a;
+  if (options.time_offset_s)
+    for (const double t : times_b_own) times_b_on_a.push_back(t + *options.time_offset_s);
+  const std::vector<double>& times_b = options.time_offset_s ? times_b_on_a : times_b_own;
+  r.time_offset_s = options.time_offset_s.value_or(0.0);
+  hots::RefineOptions hots_options = options.hots;
+  if (options.time_offset_s) {
+    hots_options.synchronise_time = false;
+    hots_options.time_offset_s = 0.0;
+    hots_options.sequence.estimate_time_offset = false;
+  }
   const std::size_t i = options.frame_index;
   if (i >= frames_a.size() || i >= frames_b.size())
     return finish(CalibrateStatus::invalid_input,
@@ -392,16 +414,22 @@ PairCalibration calibrate_pair(const FramesA& frames_a, const std::vector<double
     report("hots", 0.0);
     t0 = std::chrono::steady_clock::now();
     const hots::RefineResult h =
-        hots::refine(view_a, ta, odo.poses_a, view_b, tb, odo.poses_b, C, options.hots);
+        hots::refine(view_a, ta, odo.poses_a, view_b, tb, odo.poses_b, C, hots_options);
     r.timing_s.hots = seconds_since(t0);
     calibrate_detail::add_refine(*r.hots, h, r.timing_s.hots);
+    r.hots->time_offset_s += r.time_offset_s;  // back to b's own clock
     if (!h.ok())
       return finish(CalibrateStatus::hots_failed,
-                    std::string("HOTS: ") + hots::to_string(h.status) + ": " + h.reason);
+                    std::string("HOTS: ") + hots::to_string(h.status) + ": " + h.reason +
+                        (h.status == hots::RefineStatus::time_offset_untrusted
+                             ? "; a longer drive with turns and speed changes pins it down, "
+                               "and synchronised clocks are said so with time_offset_s = 0 "
+                               "(ulc calibrate --synced-clocks)"
+                             : ""));
     report("hots", 1.0);
     C = h.extrinsic;
     r.T_base_target = C;
-    r.time_offset_s = h.time_offset_s;
+    r.time_offset_s += h.time_offset_s;
     r.covariance_6x6 = h.covariance_6x6;
   }
   return finish(CalibrateStatus::ok, "");

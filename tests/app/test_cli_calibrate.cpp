@@ -1,7 +1,7 @@
 // `ulc calibrate` end to end: on a tiny simulated 64-32 dataset (written by `ulc simulate`),
 // --stages terra writes the result file of DESIGN.md with a rotation near the ground truth;
 // terra,jeep passes `ulc evaluate`; jeep alone takes --initial as numbers or as a result file;
-// --stages hots is accepted and runs over every frame;
+// --stages hots is accepted and runs over every frame, and --synced-clocks skips the offset;
 // a target that cannot be calibrated gives exit code 1 and still its entry; bad usage gives exit
 // code 2 and one line naming the problem; and on the real croon_0003 sample TERRA finds both
 // side LiDARs within 5 deg of the shipped calibration.
@@ -271,6 +271,20 @@ TEST_CASE("ulc calibrate --stages hots is accepted and runs odometry and HOTS ov
   CHECK(ulc::pose_error(guess, r[0].T_base_target).rotation_deg < 1e-6);
   CHECK(ulc::pose_error(guess, r[0].T_base_target).translation_m < 1e-6);
   CHECK(!r[0].covariance_6x6);
+
+  // --synced-clocks: no offset to estimate, so no synchronisation to fail, and none checked.
+  const auto synced =
+      run_command(kUlc + " calibrate --quiet --synced-clocks" + d.pair_args() +
+                  " --stages hots --initial " + quote(xyz_rpy(guess)) + " --output " + quote(out));
+  INFO(synced.output);
+  const auto rs = ulc::io::read_result_file(out);
+  REQUIRE(rs.size() == 1);
+  CHECK_THAT(rs[0].reason, !Catch::Contains("time_sync"));
+  REQUIRE(rs[0].time_offset_s);
+  CHECK(*rs[0].time_offset_s == 0.0);
+  const auto& synced_hots = rs[0].stages.at("hots");
+  CHECK(synced_hots.at("time_offset_checked").as_bool() == false);
+  CHECK(synced_hots.at("time_sync_pairs").as_number() == 0);  // the synchronisation never ran
 }
 
 TEST_CASE("a target that cannot be calibrated: exit code 1, and its entry says why",

@@ -42,7 +42,11 @@ TEST_CASE("refine improves a disturbed extrinsic on a simulated 64-32 drive", "[
   const hots::RefineResult r =
       hots::refine(a.frames, a.timestamps, pa, b.frames, b.timestamps, pb, C0, options);
   INFO(hots::to_string(r.status) << ": " << r.reason);
-  REQUIRE(r.ok());
+  // 3 s of driving does not pin a clock offset down: HOTS says so, and still returns what it
+  // refined (the offset it kept, the extrinsic, the poses).
+  REQUIRE(r.status == hots::RefineStatus::time_offset_untrusted);
+  CHECK(r.statistics.sequence.time_offset_checked);
+  CHECK(r.statistics.sequence.time_observability < options.sequence.min_time_observability);
   const auto e0 = ulc::pose_error(C_gt, C0);
   const auto e = ulc::pose_error(C_gt, r.extrinsic);
   const auto eg = ulc::pose_error(C_gt, r.statistics.graph_extrinsic);

@@ -135,7 +135,8 @@ struct PairCalibration {
   std::optional<TerraReport> terra;
   std::optional<JeepReport> jeep;
   std::optional<HotsReport> hots;
-  /// From HOTS when it succeeded; otherwise 0 (clocks assumed synchronised) and no covariance.
+  /// The known offset (CalibrateOptions::time_offset_s) or HOTS's when it succeeded; otherwise
+  /// 0 (clocks assumed synchronised). No covariance without HOTS.
   double time_offset_s = 0.0;
   std::optional<Mat6d> covariance_6x6;
   StageTimings timing_s;

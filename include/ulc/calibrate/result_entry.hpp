@@ -1,8 +1,8 @@
 // A PairCalibration as the result file's entry (DESIGN.md, "Result file"; io/result_file.hpp).
 //
 // Conventions this header owns:
-//   - time_offset_s and covariance_6x6 come from HOTS when it succeeded; otherwise the offset
-//     is 0 (clocks assumed synchronised) and the covariance null.
+//   - time_offset_s is the caller's known offset or HOTS's when it succeeded, otherwise 0
+//     (clocks assumed synchronised); covariance_6x6 is HOTS's, null without it.
 //   - "stages" holds one object per stage that ran ("terra", "jeep", "hots"); "timing_s" always
 //   holds
 //     every stage key of DESIGN.md ("terra", "jeep", "odometry", "hots", "total"), 0 for a
@@ -134,6 +134,17 @@ inline io::Json hots_to_json(const HotsReport& h) {
   j["time_offset_s"] = h.time_offset_s;
   j["time_sync_spread"] = s.time_sync_spread;
   j["time_sync_pairs"] = s.time_sync_pairs;
+  j["sync_time_offset_s"] = s.sync_time_offset_s;
+  j["sync_significant"] = s.sync_significant;
+  // The whole-sequence step's offset and its trust check (sequence_extrinsic.hpp).
+  j["joint_time_offset_s"] = s.sequence.joint_time_offset_s;
+  j["time_offset_refined"] = s.sequence.time_offset_refined;
+  j["time_offset_checked"] = s.sequence.time_offset_checked;
+  j["time_offset_trusted"] = s.sequence.time_offset_trusted;
+  io::Json halves = io::Json::array();
+  for (const double half : s.sequence.half_time_offset_s) halves.push_back(half);
+  j["half_time_offsets_s"] = std::move(halves);
+  j["time_observability"] = s.sequence.time_observability;
   io::Json curve = io::Json::array();
   for (const auto& [offset, spread] : h.spread_curve) {
     io::Json point = io::Json::array();
