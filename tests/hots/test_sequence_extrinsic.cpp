@@ -39,6 +39,21 @@ const Prepared& prepared() {
   return p;
 }
 
+/// What the whole-drive cases read: the drive, its two LiDARs, their prepared frames, the truth.
+struct DriveCase {
+  const hots_drive::Drive& d = hots_drive::drive();
+  const ulc::sim::LidarRecording& a = d.data.lidars[0];
+  const ulc::sim::LidarRecording& b = d.data.lidars[1];
+  const Prepared& p = prepared();
+  const Isometry3d C = d.data.pairs[0].T_base_target;
+
+  /// The step on the base's true trajectory, from C0 and a start offset of 0.
+  hots::SequenceExtrinsicResult solve(const std::vector<double>& times_b, const Isometry3d& C0,
+                                      const hots::SequenceExtrinsicOptions& o = {}) const {
+    return hots::sequence_extrinsic(p.ha, p.fa, a.timestamps, d.truth_a, p.fb, times_b, C0, 0.0, o);
+  }
+};
+
 }  // namespace
 
 TEST_CASE("the joint residual's Jacobian matches finite differences in C and dt",
@@ -81,20 +96,14 @@ TEST_CASE("the joint residual's Jacobian matches finite differences in C and dt"
 
 TEST_CASE("the whole-sequence step recovers the extrinsic from the base's true trajectory",
           "[hots][sequence]") {
-  const auto& d = hots_drive::drive();
-  const auto& a = d.data.lidars[0];
-  const auto& b = d.data.lidars[1];
-  const Prepared& p = prepared();
-  const Isometry3d C_gt = d.data.pairs[0].T_base_target;
+  const DriveCase c;
+  const Isometry3d& C_gt = c.C;
   std::mt19937_64 rng(5);
   const Isometry3d C0 = jeep_test::disturbed(C_gt, rng, 0.3 * kDeg, 0.05);
   hots::SequenceExtrinsicOptions o;
   o.estimate_time_offset = false;
   o.frame_stride = 2;  // the test drive is short: more of its frames
-  auto run = [&] {
-    return hots::sequence_extrinsic(p.ha, p.fa, a.timestamps, d.truth_a, p.fb, b.timestamps, C0,
-                                    0.0, o);
-  };
+  auto run = [&] { return c.solve(c.b.timestamps, C0, o); };
   const hots::SequenceExtrinsicResult r = run();
   INFO(hots::to_string(r.status) << ": " << r.reason);
   REQUIRE(r.ok());
@@ -144,21 +153,17 @@ TEST_CASE("time observability is the share of dt's information C cannot explain"
 }
 
 TEST_CASE("the trust check flags a clock offset the synchronisation missed", "[hots][sequence]") {
-  const auto& d = hots_drive::drive();
-  const auto& a = d.data.lidars[0];
-  const auto& b = d.data.lidars[1];
-  const Prepared& p = prepared();
-  const Isometry3d C = d.data.pairs[0].T_base_target;
+  const DriveCase c;
+  const Isometry3d& C = c.C;
   hots::SequenceExtrinsicOptions o;
   o.estimate_time_offset = false;  // as after a synchronisation that found no offset
   o.frame_stride = 2;
   // b's clock 50 ms behind: t_a = t_b + 0.05, while the step is told 0.
   const double offset = 0.05;
-  std::vector<double> late_b = b.timestamps;
+  std::vector<double> late_b = c.b.timestamps;
   for (double& t : late_b) t -= offset;
   auto run = [&](const std::vector<double>& times_b, const hots::SequenceExtrinsicOptions& opt) {
-    const auto r =
-        hots::sequence_extrinsic(p.ha, p.fa, a.timestamps, d.truth_a, p.fb, times_b, C, 0.0, opt);
+    const auto r = c.solve(times_b, C, opt);
     INFO("joint " << r.joint_time_offset_s * 1e3 << " ms, observability " << r.time_observability
                   << ", halves " << r.half_time_offset_s[0] * 1e3 << ", "
                   << r.half_time_offset_s[1] * 1e3 << " ms: " << r.time_offset_doubt);
@@ -172,14 +177,14 @@ TEST_CASE("the trust check flags a clock offset the synchronisation missed", "[h
   CHECK(missed.time_observability < o.min_time_observability);
   CHECK(missed.time_offset_s == 0.0);  // reported, not adopted
   CHECK(std::abs(missed.joint_time_offset_s - offset) < 0.01);
-  CHECK_FALSE(run(b.timestamps, o).time_offset_trusted);
+  CHECK_FALSE(run(c.b.timestamps, o).time_offset_trusted);
 
   // The other two criteria alone: the missed offset is still caught (the whole drive's
   // registration points 50 ms away), the right clocks pass with halves that agree.
   hots::SequenceExtrinsicOptions lenient = o;
   lenient.min_time_observability = 0.0;
   CHECK_FALSE(run(late_b, lenient).time_offset_trusted);
-  const auto right = run(b.timestamps, lenient);
+  const auto right = run(c.b.timestamps, lenient);
   CHECK(right.time_offset_trusted);
   CHECK(std::abs(right.half_time_offset_s[0] - right.half_time_offset_s[1]) <
         o.max_time_disagreement_s);
@@ -187,23 +192,18 @@ TEST_CASE("the trust check flags a clock offset the synchronisation missed", "[h
 }
 
 TEST_CASE("the whole-sequence step refuses bad input and can be switched off", "[hots][sequence]") {
-  const auto& d = hots_drive::drive();
-  const auto& a = d.data.lidars[0];
-  const auto& b = d.data.lidars[1];
-  const Prepared& p = prepared();
-  const Isometry3d C = d.data.pairs[0].T_base_target;
+  const DriveCase c;
+  const Isometry3d& C = c.C;
   hots::SequenceExtrinsicOptions off;
   off.enabled = false;
-  const auto r0 = hots::sequence_extrinsic(p.ha, p.fa, a.timestamps, d.truth_a, p.fb, b.timestamps,
-                                           C, 0.0, off);
+  const auto r0 = c.solve(c.b.timestamps, C, off);
   CHECK(r0.status == hots::SequenceExtrinsicStatus::disabled);
   CHECK(r0.extrinsic.matrix() == C.matrix());
   hots::SequenceExtrinsicOptions bad;
   bad.stages.clear();
-  CHECK(
-      hots::sequence_extrinsic(p.ha, p.fa, a.timestamps, d.truth_a, p.fb, b.timestamps, C, 0.0, bad)
-          .status == hots::SequenceExtrinsicStatus::invalid_input);
-  const std::vector<Isometry3d> short_poses(d.truth_a.begin(), d.truth_a.begin() + 2);
-  CHECK(hots::sequence_extrinsic(p.ha, p.fa, a.timestamps, short_poses, p.fb, b.timestamps, C, 0.0)
+  CHECK(c.solve(c.b.timestamps, C, bad).status == hots::SequenceExtrinsicStatus::invalid_input);
+  const std::vector<Isometry3d> short_poses(c.d.truth_a.begin(), c.d.truth_a.begin() + 2);
+  CHECK(hots::sequence_extrinsic(c.p.ha, c.p.fa, c.a.timestamps, short_poses, c.p.fb,
+                                 c.b.timestamps, C, 0.0)
             .status == hots::SequenceExtrinsicStatus::invalid_input);
 }
