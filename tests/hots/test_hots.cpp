@@ -71,6 +71,40 @@ TEST_CASE("refine improves a disturbed extrinsic on a simulated 64-32 drive", "[
   CHECK(r.covariance_6x6.trace() > 0.0);
 }
 
+TEST_CASE("the odometry's steps tie the top layer's submaps together", "[hots][refine]") {
+  // One BA layer over 3 s: six 5-frame submaps that no window spans. Without the boundary
+  // factors each submap keeps its first frame where the drifting odometry put it.
+  const Drive& d = drive();
+  const auto& a = d.data.lidars[0];
+  const auto& b = d.data.lidars[1];
+  const auto pa = drifting(d.truth_a, a.timestamps, 1);
+  const auto pb = drifting(d.truth_b, b.timestamps, 2);
+  hots::RefineOptions options;
+  options.hierarchy.layers = 1;
+  options.synchronise_time = false;  // the clocks agree; 3 s could not show it anyway
+  auto run = [&](double sigma_m) {
+    options.boundary_sigma_m = sigma_m;
+    return hots::refine(a.frames, a.timestamps, pa, b.frames, b.timestamps, pb,
+                        d.data.pairs[0].T_base_target, options);
+  };
+  const auto tied = run(0.02);
+  const auto loose = run(0.0);
+  INFO(hots::to_string(tied.status) << ": " << tied.reason);
+  REQUIRE(tied.ok());
+  REQUIRE(loose.ok());
+  const std::size_t submaps_a = (a.frames.size() + 4) / 5, submaps_b = (b.frames.size() + 4) / 5;
+  CHECK(tied.statistics.boundary_factors == submaps_a - 1 + submaps_b - 1);
+  CHECK(loose.statistics.boundary_factors == 0);
+  const double odometry = ate(d.truth_a, pa);
+  const double with_ties = ate(d.truth_a, tied.poses_a);
+  const double without = ate(d.truth_a, loose.poses_a);
+  INFO("ATE of a: odometry " << odometry << ", with boundary factors " << with_ties << ", without "
+                             << without);
+  // Measured: 1.95 cm -> 0.97 cm with them, 8.6 cm without (worse than the odometry).
+  CHECK(with_ties < odometry);
+  CHECK(with_ties < 0.5 * without);
+}
+
 TEST_CASE("refine reports unusable input", "[hots][refine]") {
   const Drive& d = drive();
   const auto& a = d.data.lidars[0];
