@@ -5,6 +5,10 @@
 //   bench_hots --time-offset [--scenarios 64-32,64-horizon] [--seconds 60] [--runs 10]
 //                            [--spread-png PREFIX]
 //   common: [--decimation 1] [--threads 2] [--deskew-from-base] [--first-run 0] [--json]
+//           [--layers N] [--trajectory PREFIX]
+//   --layers N: HOTS's hierarchy layers (default: HierarchyOptions' 3, the paper's).
+//   --trajectory PREFIX: per run, PREFIX_<scenario>_run<k>.csv with the base's true, odometry and
+//   HOTS positions and each one's frame-to-frame motion error (to see where a drift comes from).
 //   --deskew-from-base: the whole-sequence step reads b's frames deskewed afresh with the
 //   base's refined trajectory (SequenceExtrinsicOptions::deskew_from_base) instead of b's own
 //   odometry.
@@ -21,10 +25,14 @@
 // y the corrected spread in cm^2, a solid green line at the true offset and a dashed red one at
 // HOTS's final estimate (support/curve_png.hpp).
 // ATE: RMS translation error of the base LiDAR's poses (odometry's, then HOTS's) against the
-// simulator's trajectory, both in the base frame at its first timestamp.
+// simulator's trajectory, both in the base frame at its first timestamp; ate_aligned_*: the same
+// after the best rigid alignment of the whole trajectory (the TUM/evo definition). The stderr line
+// of each run adds the relative pose error (RMS translation error of the motion over 1, 5, 25, 125,
+// 250, 500 frames), odometry -> HOTS: which time scales HOTS improves.
 // A 60 s full-rate drive holds every frame in memory (several GB for 64-beam rigs):
 // --decimation N keeps every Nth point.
 #include <tbb/task_arena.h>
+#include <Eigen/SVD>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -64,6 +72,8 @@ struct Config {
   bool deskew_from_base = false;  ///< --deskew-from-base
   double pre_shift_s = 0.0;       ///< --pre-shift-ms
   bool no_traffic = false;        ///< --no-traffic: the scenario without its oncoming cars
+  int layers = 0;                 ///< --layers: HOTS hierarchy layers; 0: the default
+  std::string trajectory;         ///< --trajectory PREFIX: per-frame poses of each run, as CSV
   ulc_bench::Options bench;
 };
 
@@ -92,12 +102,94 @@ double ate(const ulc::sim::Dataset& d, std::size_t lidar, const std::vector<Isom
   return std::sqrt(sum / static_cast<double>(t.size()));
 }
 
+/// The same RMS after the rigid motion that best aligns the estimate with the truth (Horn's
+/// closed form, as the TUM RGB-D benchmark and evo define the ATE): free of the error that a
+/// small rotation at the first frame spreads along the whole drive.
+double ate_aligned(const ulc::sim::Dataset& d, std::size_t lidar,
+                   const std::vector<Isometry3d>& est) {
+  const auto& t = d.lidars[lidar].timestamps;
+  const double n = static_cast<double>(t.size());
+  std::vector<ulc::Vec3d> g, e;
+  ulc::Vec3d gm = ulc::Vec3d::Zero(), em = ulc::Vec3d::Zero();
+  for (std::size_t k = 0; k < t.size(); ++k) {
+    g.push_back(jeep_test::lidar_pose(d, lidar, t[k]).translation());
+    e.push_back(est[k].translation());
+    gm += g.back() / n;
+    em += e.back() / n;
+  }
+  Eigen::Matrix3d W = Eigen::Matrix3d::Zero();
+  for (std::size_t k = 0; k < g.size(); ++k) W += (g[k] - gm) * (e[k] - em).transpose();
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(W, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d D = Eigen::Matrix3d::Identity();
+  if ((svd.matrixU() * svd.matrixV().transpose()).determinant() < 0) D(2, 2) = -1.0;
+  const Eigen::Matrix3d R = svd.matrixU() * D * svd.matrixV().transpose();
+  double sum = 0.0;
+  for (std::size_t k = 0; k < g.size(); ++k) sum += (R * (e[k] - em) + gm - g[k]).squaredNorm();
+  return std::sqrt(sum / n);
+}
+
+/// RMS translation error (m) of the relative motion over `lag` frames of `est` against the
+/// simulator's (the relative pose error): where along the time scale a trajectory's error lives.
+double rpe(const ulc::sim::Dataset& d, std::size_t lidar, const std::vector<Isometry3d>& est,
+           std::size_t lag) {
+  const auto& t = d.lidars[lidar].timestamps;
+  double sum = 0.0;
+  std::size_t n = 0;
+  for (std::size_t k = 0; k + lag < t.size(); ++k, ++n) {
+    const Isometry3d truth = jeep_test::lidar_pose(d, lidar, t[k]).inverse() *
+                             jeep_test::lidar_pose(d, lidar, t[k + lag]);
+    sum += (truth.inverse() * est[k].inverse() * est[k + lag]).translation().squaredNorm();
+  }
+  return n ? std::sqrt(sum / static_cast<double>(n)) : 0.0;
+}
+
+/// "lag 1: odometry -> HOTS cm, lag 5: ..." for the stderr log.
+std::string rpe_line(const ulc::sim::Dataset& d, const std::vector<Isometry3d>& odometry,
+                     const std::vector<Isometry3d>& refined) {
+  std::ostringstream s;
+  s << "RPE (cm)";
+  for (const std::size_t lag : {1, 5, 25, 125, 250, 500})
+    if (lag < odometry.size())
+      s << ", lag " << lag << ": " << 100 * rpe(d, 0, odometry, lag) << " -> "
+        << 100 * rpe(d, 0, refined, lag);
+  return s.str();
+}
+
+/// Per frame of the base: time, the truth's, the odometry's and HOTS's positions (in the base's
+/// frame at its first timestamp) and each one's frame-to-frame motion error (m), as CSV.
+void write_trajectory(const std::string& path, const ulc::sim::Dataset& d,
+                      const std::vector<Isometry3d>& odometry,
+                      const std::vector<Isometry3d>& refined) {
+  std::ofstream out(path);
+  const auto& t = d.lidars[0].timestamps;
+  const Isometry3d origin = jeep_test::lidar_pose(d, 0, t.front()).inverse();
+  out << "t,truth_x,truth_y,truth_z,odo_x,odo_y,odo_z,hots_x,hots_y,hots_z,odo_step_err,"
+         "hots_step_err\n";
+  for (std::size_t k = 0; k < t.size(); ++k) {
+    const Isometry3d g = origin * jeep_test::lidar_pose(d, 0, t[k]);
+    auto step_error = [&](const std::vector<Isometry3d>& e) {
+      if (k == 0) return 0.0;
+      const Isometry3d g0 = origin * jeep_test::lidar_pose(d, 0, t[k - 1]);
+      return ((g0.inverse() * g).inverse() * e[k - 1].inverse() * e[k]).translation().norm();
+    };
+    out << t[k] << "," << g.translation().x() << "," << g.translation().y() << ","
+        << g.translation().z() << "," << odometry[k].translation().x() << ","
+        << odometry[k].translation().y() << "," << odometry[k].translation().z() << ","
+        << refined[k].translation().x() << "," << refined[k].translation().y() << ","
+        << refined[k].translation().z() << "," << step_error(odometry) << "," << step_error(refined)
+        << "\n";
+  }
+  std::cerr << "bench_hots: wrote " << path << "\n";
+}
+
 struct Run {
   bool jeep_ok = false, hots_ok = false;
   std::string status;
   ulc::PoseError jeep_error, hots_error, sync_error;
   double dt_error_s = 0.0, sync_dt_error_s = 0.0;
   double ate_odometry = 0.0, ate_hots = 0.0;
+  double ate_aligned_odometry = 0.0, ate_aligned_hots = 0.0;
+  std::string rpe;  ///< rpe_line of odometry and HOTS
   hots::SequenceExtrinsicResult sequence;
   double sequence_s = 0.0;
   double odometry_s = 0.0, hots_s = 0.0;
@@ -133,6 +225,7 @@ Run one_run(const std::string& scenario, double offset_s, std::size_t run, const
     o.stages = {ulc::Stage::jeep};
     o.initial = initial;
     o.hots.sequence.deskew_from_base = c.deskew_from_base;
+    if (c.layers > 0) o.hots.hierarchy.layers = c.layers;
     const auto j = ulc::calibrate_pair(a.frames, a.timestamps, b.frames, times_b, o);
     out.status = ulc::to_string(j.status);
     out.jeep_ok = j.success;
@@ -149,6 +242,7 @@ Run one_run(const std::string& scenario, double offset_s, std::size_t run, const
       return;
     }
     out.ate_odometry = ate(d, 0, odo.poses_a);
+    out.ate_aligned_odometry = ate_aligned(d, 0, odo.poses_a);
     t0 = std::chrono::steady_clock::now();
     const auto h = hots::refine(a.frames, a.timestamps, odo.poses_a, b.frames, times_b, odo.poses_b,
                                 C, o.hots);
@@ -166,6 +260,11 @@ Run one_run(const std::string& scenario, double offset_s, std::size_t run, const
     out.sequence_s = h.statistics.sequence_seconds;
     out.sync_dt_error_s = h.statistics.sync_time_offset_s - true_offset;
     out.ate_hots = ate(d, 0, h.poses_a);
+    out.ate_aligned_hots = ate_aligned(d, 0, h.poses_a);
+    out.rpe = rpe_line(d, odo.poses_a, h.poses_a);
+    if (!c.trajectory.empty())
+      write_trajectory(c.trajectory + "_" + scenario + "_run" + std::to_string(run) + ".csv", d,
+                       odo.poses_a, h.poses_a);
   });
   return out;
 }
@@ -207,10 +306,25 @@ void bench(Config c) {
                                                      "64-horizon", "32-avia", "64-tele"};
   const std::vector<double> offset_list =
       offsets ? std::vector<double>{0.05, 0.0} : std::vector<double>{0.0};
-  ulc_bench::Table table({"scenario", "offset_ms", "runs", "jeep_success_pct", "hots_success_pct",
-                          "jeep_e_rot_deg", "sync_e_rot_deg", "hots_e_rot_deg", "jeep_e_trans_cm",
-                          "sync_e_trans_cm", "hots_e_trans_cm", "sync_dt_error_ms", "dt_error_ms",
-                          "ate_odometry_cm", "ate_hots_cm", "offset_untrusted", "odometry_s",
+  ulc_bench::Table table({"scenario",
+                          "offset_ms",
+                          "runs",
+                          "jeep_success_pct",
+                          "hots_success_pct",
+                          "jeep_e_rot_deg",
+                          "sync_e_rot_deg",
+                          "hots_e_rot_deg",
+                          "jeep_e_trans_cm",
+                          "sync_e_trans_cm",
+                          "hots_e_trans_cm",
+                          "sync_dt_error_ms",
+                          "dt_error_ms",
+                          "ate_odometry_cm",
+                          "ate_hots_cm",
+                          "ate_aligned_odometry_cm",
+                          "ate_aligned_hots_cm",
+                          "offset_untrusted",
+                          "odometry_s",
                           "hots_s"});
   for (const auto& scenario : c.scenarios) {
     if (!ulc::sim::scenario(scenario)) {
@@ -218,7 +332,7 @@ void bench(Config c) {
       std::exit(2);
     }
     for (const double offset : offset_list) {
-      std::vector<double> jr, hr, jt, ht, dt, ao, ah, so, sh, yr, yt, ydt;
+      std::vector<double> jr, hr, jt, ht, dt, ao, ah, aao, aah, so, sh, yr, yt, ydt;
       std::size_t jeep_ok = 0, hots_ok = 0, untrusted = 0;
       for (std::size_t run = c.first_run; run < c.first_run + c.runs; ++run) {
         const Run r = one_run(scenario, offset, run, c);
@@ -237,6 +351,8 @@ void bench(Config c) {
         ydt.push_back(std::abs(r.sync_dt_error_s));
         ao.push_back(r.ate_odometry);
         ah.push_back(r.ate_hots);
+        aao.push_back(r.ate_aligned_odometry);
+        aah.push_back(r.ate_aligned_hots);
         so.push_back(r.odometry_s);
         sh.push_back(r.hots_s);
         if (!c.bench.json)
@@ -247,7 +363,8 @@ void bench(Config c) {
                     << r.sync_dt_error_s * 1e3 << " ms; HOTS " << r.hots_error.rotation_deg
                     << " deg " << r.hots_error.translation_m * 100 << " cm, dt error "
                     << r.dt_error_s * 1e3 << " ms, ATE " << r.ate_odometry * 100 << " -> "
-                    << r.ate_hots * 100 << " cm (" << r.odometry_s << " + " << r.hots_s
+                    << r.ate_hots * 100 << " cm (aligned " << r.ate_aligned_odometry * 100 << " -> "
+                    << r.ate_aligned_hots * 100 << " cm) (" << r.odometry_s << " + " << r.hots_s
                     << " s); sequence: joint dt " << r.sequence.joint_time_offset_s * 1e3
                     << " ms sigma " << r.sequence.time_sigma_s * 1e3 << " ms observability "
                     << r.sequence.time_observability << " adopted "
@@ -256,22 +373,32 @@ void bench(Config c) {
                     << r.sequence.half_time_offset_s[1] * 1e3 << " ms trusted "
                     << r.sequence.time_offset_trusted << " (" << r.sequence.time_offset_doubt
                     << "), " << r.sequence.iterations << " matchings, " << r.sequence.source_points
-                    << " points, " << r.sequence_s << " s\n";
+                    << " points, " << r.sequence_s << " s; " << r.rpe << "\n";
         if (offsets && run == c.first_run && !c.spread_png.empty())
           write_spread_png(r, scenario, offset, c);
       }
       const double n = static_cast<double>(c.runs);
       using jeep_test::median;
-      table.add_row(
-          {scenario, Cell::num(offset * 1e3, 0), Cell::integer(static_cast<long long>(c.runs)),
-           Cell::num(100.0 * static_cast<double>(jeep_ok) / n, 1),
-           Cell::num(100.0 * static_cast<double>(hots_ok) / n, 1), Cell::num(median(jr), 4),
-           Cell::num(median(yr), 4), Cell::num(median(hr), 4), Cell::num(100 * median(jt), 2),
-           Cell::num(100 * median(yt), 2), Cell::num(100 * median(ht), 2),
-           Cell::num(1e3 * median(ydt), 2), Cell::num(1e3 * median(dt), 2),
-           Cell::num(100 * median(ao), 2), Cell::num(100 * median(ah), 2),
-           Cell::integer(static_cast<long long>(untrusted)), Cell::num(median(so), 2),
-           Cell::num(median(sh), 2)});
+      table.add_row({scenario,
+                     Cell::num(offset * 1e3, 0),
+                     Cell::integer(static_cast<long long>(c.runs)),
+                     Cell::num(100.0 * static_cast<double>(jeep_ok) / n, 1),
+                     Cell::num(100.0 * static_cast<double>(hots_ok) / n, 1),
+                     Cell::num(median(jr), 4),
+                     Cell::num(median(yr), 4),
+                     Cell::num(median(hr), 4),
+                     Cell::num(100 * median(jt), 2),
+                     Cell::num(100 * median(yt), 2),
+                     Cell::num(100 * median(ht), 2),
+                     Cell::num(1e3 * median(ydt), 2),
+                     Cell::num(1e3 * median(dt), 2),
+                     Cell::num(100 * median(ao), 2),
+                     Cell::num(100 * median(ah), 2),
+                     Cell::num(100 * median(aao), 2),
+                     Cell::num(100 * median(aah), 2),
+                     Cell::integer(static_cast<long long>(untrusted)),
+                     Cell::num(median(so), 2),
+                     Cell::num(median(sh), 2)});
     }
   }
   std::string list;
@@ -287,6 +414,9 @@ void bench(Config c) {
        {{"success", "status ok and e_rot < 1 deg and e_trans < 10 cm"},
         {"medians", "over all runs, failures included (a failed HOTS counts JEEP's error)"},
         {"dt_error", "|estimated - true clock offset|; the true offset when HOTS did not run"},
+        {"ate",
+         "RMS position error of the base's poses, first frames aligned; ate_aligned_*: "
+         "after the best rigid alignment of the whole trajectory"},
         {"offset_untrusted",
          "runs whose HOTS refused its clock offset (time_offset_untrusted: a failure above)"},
         {"sync",
@@ -321,6 +451,10 @@ int main(int argc, char** argv) {
       c.spread_png = argv[++i];
     } else if (a == "--pre-shift-ms" && value) {
       c.pre_shift_s = std::atof(argv[++i]) * 1e-3;
+    } else if (a == "--layers" && value) {
+      c.layers = std::max(1, std::atoi(argv[++i]));
+    } else if (a == "--trajectory" && value) {
+      c.trajectory = argv[++i];
     } else if (a == "--no-traffic") {
       c.no_traffic = true;
     } else if (a == "--deskew-from-base") {
