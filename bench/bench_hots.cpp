@@ -5,10 +5,14 @@
 //   bench_hots --time-offset [--scenarios 64-32,64-horizon] [--seconds 60] [--runs 10]
 //                            [--spread-png PREFIX]
 //   common: [--decimation 1] [--threads 2] [--deskew-from-base] [--first-run 0] [--json]
-//           [--layers N] [--trajectory PREFIX]
+//           [--layers N] [--trajectory PREFIX] [--hots NAME=VALUE ...]
 //   --layers N: HOTS's hierarchy layers (default: HierarchyOptions' 3, the paper's).
 //   --trajectory PREFIX: per run, PREFIX_<scenario>_run<k>.csv with the base's true, odometry and
 //   HOTS positions and each one's frame-to-frame motion error (to see where a drift comes from).
+//   --hots NAME=VALUE (repeatable): one of HOTS's numeric options by name, for experiments
+//   without a rebuild: plane_voxel, plane_depth, plane_ratio, plane_distance, frame_voxel,
+//   submap_voxel, boundary_registration (0/1), boundary_sigma_m, boundary_sigma_rad,
+//   extrinsic_sigma_m, extrinsic_sigma_rad, link_min_layer, rounds, window, synchronise_time (0/1).
 //   --deskew-from-base: the whole-sequence step reads b's frames deskewed afresh with the
 //   base's refined trajectory (SequenceExtrinsicOptions::deskew_from_base) instead of b's own
 //   odometry.
@@ -39,6 +43,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <random>
 #include <sstream>
@@ -74,8 +79,39 @@ struct Config {
   bool no_traffic = false;        ///< --no-traffic: the scenario without its oncoming cars
   int layers = 0;                 ///< --layers: HOTS hierarchy layers; 0: the default
   std::string trajectory;         ///< --trajectory PREFIX: per-frame poses of each run, as CSV
+  std::vector<std::string> hots_settings;  ///< --hots NAME=VALUE, applied in order
   ulc_bench::Options bench;
 };
+
+/// --hots NAME=VALUE: one of HOTS's numeric options by name (experiments without a rebuild).
+void apply_hots_setting(hots::RefineOptions& o, const std::string& setting) {
+  const auto eq = setting.find('=');
+  const std::string name = setting.substr(0, eq);
+  const double v = eq == std::string::npos ? 0.0 : std::atof(setting.c_str() + eq + 1);
+  auto& planes = o.hierarchy.ba.planes;
+  const auto as_int = [&] { return static_cast<int>(v); };
+  const std::vector<std::pair<const char*, std::function<void()>>> setters = {
+      {"plane_voxel", [&] { planes.voxel_size = v; }},
+      {"plane_depth", [&] { planes.max_depth = as_int(); }},
+      {"plane_ratio", [&] { planes.max_eigen_ratio = v; }},
+      {"plane_distance", [&] { planes.max_distance = v; }},
+      {"frame_voxel", [&] { o.frame_voxel = v; }},
+      {"submap_voxel", [&] { o.hierarchy.submap_voxel = v; }},
+      {"boundary_registration", [&] { o.boundary_registration = v != 0.0; }},
+      {"boundary_sigma_m", [&] { o.boundary_sigma_m = v; }},
+      {"boundary_sigma_rad", [&] { o.boundary_sigma_rad = v; }},
+      {"extrinsic_sigma_m", [&] { o.extrinsic_sigma_m = v; }},
+      {"extrinsic_sigma_rad", [&] { o.extrinsic_sigma_rad = v; }},
+      {"link_min_layer", [&] { o.links.min_layer = as_int(); }},
+      {"rounds", [&] { o.hierarchy.ba.rounds = as_int(); }},
+      {"window", [&] { o.hierarchy.window = static_cast<std::size_t>(v); }},
+      {"synchronise_time", [&] { o.synchronise_time = v != 0.0; }},
+  };
+  for (const auto& [key, set] : setters)
+    if (name == key) return set();
+  std::cerr << "bench_hots: unknown --hots setting '" << name << "'\n";
+  std::exit(2);
+}
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -226,6 +262,7 @@ Run one_run(const std::string& scenario, double offset_s, std::size_t run, const
     o.initial = initial;
     o.hots.sequence.deskew_from_base = c.deskew_from_base;
     if (c.layers > 0) o.hots.hierarchy.layers = c.layers;
+    for (const auto& setting : c.hots_settings) apply_hots_setting(o.hots, setting);
     const auto j = ulc::calibrate_pair(a.frames, a.timestamps, b.frames, times_b, o);
     out.status = ulc::to_string(j.status);
     out.jeep_ok = j.success;
@@ -455,6 +492,8 @@ int main(int argc, char** argv) {
       c.layers = std::max(1, std::atoi(argv[++i]));
     } else if (a == "--trajectory" && value) {
       c.trajectory = argv[++i];
+    } else if (a == "--hots" && value) {
+      c.hots_settings.push_back(argv[++i]);
     } else if (a == "--no-traffic") {
       c.no_traffic = true;
     } else if (a == "--deskew-from-base") {

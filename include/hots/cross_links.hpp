@@ -16,13 +16,15 @@
 //     bench_hots (64-32): 2.3x faster and no less accurate than the 0.1 m frames; the
 //     information (Hessian of fewer points) is smaller, which weights links less against the
 //     windows' BA; accuracy did not suffer from that (scaling it back up was worse).
-//   - A link is kept when the registration is ok and its inlier ratio >= min_inlier_ratio.
+//   - A link is kept when the registration is ok and its inlier ratio >= min_inlier_ratio
+//     (register_clouds, also used by boundary_links.hpp).
 //   - Registrations run as TBB tasks, one slot each; the kept links are in (layer, a member)
 //     order. Nothing here throws or prints.
 #pragma once
 
 #include <cmath>
 #include <cstddef>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -84,6 +86,31 @@ const std::vector<ulc::Vec3<S>>& thinned(const std::vector<ulc::Vec3<S>>& cloud,
 
 }  // namespace cross_link_detail
 
+/// `source` registered to `target`'s planes from `initial` (both thinned first): the measured
+/// T_target_source and its information, or nothing when the registration is unusable
+/// (anchors and layer are left for the caller).
+template <typename S>
+std::optional<CrossLink> register_clouds(const std::vector<ulc::Vec3<S>>& target,
+                                         const std::vector<ulc::Vec3<S>>& source,
+                                         const Isometry3d& initial, const CrossLinkOptions& options,
+                                         const std::vector<ulc::RegistrationOptions>& stages) {
+  if (target.empty() || source.empty()) return std::nullopt;
+  std::vector<ulc::Vec3<S>> thin_target, thin_source;
+  const ulc::PlaneCloud<S> planes(
+      cross_link_detail::thinned(target, options.target_voxel, thin_target), options.planes);
+  if (planes.empty()) return std::nullopt;
+  const auto reg = ulc::register_point_to_plane(
+      cross_link_detail::thinned(source, options.source_voxel, thin_source), planes, initial,
+      stages);
+  if (!reg.ok() || reg.inlier_ratio() < options.min_inlier_ratio) return std::nullopt;
+  CrossLink link;
+  link.measured = reg.pose.template cast<double>();
+  const double sigma = std::max(reg.rmse, options.min_sigma);
+  link.information = reg.hessian / (sigma * sigma);
+  link.rmse = reg.rmse;
+  return link;
+}
+
 template <typename S>
 std::vector<CrossLink> cross_links(
     const HierarchyResult<S>& ha, const std::vector<std::vector<ulc::Vec3<S>>>& frames_a,
@@ -112,25 +139,14 @@ std::vector<CrossLink> cross_links(
                           const auto& b = mb[cross_link_detail::nearest(tb, times_a[a.begin])];
                           const auto& cloud_a = l == 0 ? frames_a[a.begin] : a.cloud;
                           const auto& cloud_b = l == 0 ? frames_b[b.begin] : b.cloud;
-                          if (cloud_a.empty() || cloud_b.empty()) continue;
-                          std::vector<ulc::Vec3<S>> thin_a, thin_b;
-                          const ulc::PlaneCloud<S> target(
-                              cross_link_detail::thinned(cloud_a, options.target_voxel, thin_a),
-                              options.planes);
-                          if (target.empty()) continue;
                           const Isometry3d initial = poses_a[a.begin].inverse() * poses_b[b.begin];
-                          const auto reg = ulc::register_point_to_plane(
-                              cross_link_detail::thinned(cloud_b, options.source_voxel, thin_b),
-                              target, initial, stages);
-                          if (!reg.ok() || reg.inlier_ratio() < options.min_inlier_ratio) continue;
-                          CrossLink& link = slot[c];
-                          link.frame_a = a.begin;
-                          link.frame_b = b.begin;
-                          link.measured = reg.pose.template cast<double>();
-                          const double sigma = std::max(reg.rmse, options.min_sigma);
-                          link.information = reg.hessian / (sigma * sigma);
-                          link.layer = static_cast<int>(l);
-                          link.rmse = reg.rmse;
+                          const auto link =
+                              register_clouds(cloud_a, cloud_b, initial, options, stages);
+                          if (!link) continue;
+                          slot[c] = *link;
+                          slot[c].frame_a = a.begin;
+                          slot[c].frame_b = b.begin;
+                          slot[c].layer = static_cast<int>(l);
                           keep[c] = 1;
                         }
                       });

@@ -21,9 +21,10 @@
 //     velocity), then voxel-downsampled (frame_voxel).
 //   - Pose graph: one variable per frame of a and b (T_world_frame) and one for C; a's first
 //     frame is the gauge. Factors: every window's BA (information from its Hessian), every
-//     cross link (Huber), the odometry's step across each boundary between two top-layer
-//     submaps (no window spans it: without it each top submap would float on its own, held
-//     only by the damping), and for every b frame an extrinsic tie to the a frame nearest its
+//     cross link (Huber), each boundary between two top-layer submaps (no window spans it:
+//     without a factor each top submap would float on its own, held only by the damping):
+//     the two submaps registered to each other (boundary_links.hpp), or where that fails the
+//     odometry's step across it, and for every b frame an extrinsic tie to the a frame nearest its
 //     instant, with a's motion to that instant taken from the current poses:
 //     r = log((T_a L)^-1 T_b C^-1) (isotropic information, extrinsic_sigma_*). The ties know the
 //     clock offset only through the current estimate, so they are deliberately weak: the
@@ -53,6 +54,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "hots/boundary_links.hpp"
 #include "hots/cross_links.hpp"
 #include "hots/hierarchy.hpp"
 #include "hots/pose_graph.hpp"
@@ -76,10 +78,12 @@ struct RefineOptions {
   double extrinsic_sigma_m = 0.05;     ///< per tie
   double extrinsic_sigma_rad = 0.003;  ///< per tie
   double link_huber = 3.0;             ///< whitened units
-  /// The hierarchy's top-layer submaps share no BA window, so nothing in the graph ties one to
-  /// the next: the odometry's step across each such boundary (last frame of a submap to the
-  /// first of the next) becomes a factor with these standard deviations (per LiDAR).
-  /// <= 0: no boundary factors.
+  /// The hierarchy's top-layer submaps share no BA window, so nothing in the graph would tie
+  /// one to the next. With boundary_registration each submap is registered to the next
+  /// (boundary_links.hpp, Huber link_huber); where that fails, or without it, the odometry's
+  /// step across the boundary (last frame of a submap to the first of the next) becomes a
+  /// factor with these standard deviations. sigma <= 0 and no registration: no boundary factors.
+  bool boundary_registration = true;
   double boundary_sigma_m = 0.02;
   double boundary_sigma_rad = 0.002;
   double time_offset_s = 0.0;  ///< initial clock offset estimate (centre of the search)
@@ -120,7 +124,8 @@ inline const char* to_string(RefineStatus s) {
 struct RefineStatistics {
   std::size_t windows = 0, failed_windows = 0, planes = 0;
   std::size_t ba_factors = 0, cross_links = 0, cross_links_attempted = 0, extrinsic_ties = 0;
-  std::size_t boundary_factors = 0;  ///< odometry steps across top-layer submap boundaries
+  std::size_t boundary_factors = 0;  ///< top-layer submap boundaries tied in the graph
+  std::size_t boundary_links = 0;    ///< of those, by registering the submaps (the rest: odometry)
   double graph_initial_cost = 0.0, graph_cost = 0.0;
   int graph_iterations = 0;
   double time_sync_spread = 0.0;
@@ -298,6 +303,13 @@ RefineResult refine(const FramesA& frames_a, const std::vector<double>& times_a,
                                  options.time_offset_s, options.links, &link_stats);
   st.cross_links = links.size();
   st.cross_links_attempted = link_stats.attempted;
+  using BoundaryLinks = std::vector<std::optional<CrossLink>>;
+  const BoundaryLinks boundary_a = options.boundary_registration
+                                       ? boundary_links(ha, fa, world_a, options.links)
+                                       : BoundaryLinks{};
+  const BoundaryLinks boundary_b = options.boundary_registration
+                                       ? boundary_links(hb, fb, world_b, options.links)
+                                       : BoundaryLinks{};
   st.links_seconds = d::lap(clock);
 
   const std::size_t na = frames_a.size(), nb = frames_b.size();
@@ -322,23 +334,32 @@ RefineResult refine(const FramesA& frames_a, const std::vector<double>& times_a,
   st.ba_factors = ha.factors.size() + hb.factors.size();
   for (const auto& l : links)
     add_relative(l.frame_a, na + l.frame_b, l.measured, l.information, options.link_huber, 1);
-  if (options.boundary_sigma_m > 0.0 && options.boundary_sigma_rad > 0.0) {
-    const Mat6d sqrt_info =
-        isotropic_sqrt_information(options.boundary_sigma_m, options.boundary_sigma_rad);
-    auto add_boundaries = [&](const auto& hierarchy, const std::vector<Isometry3d>& odometry,
-                              std::size_t first_var) {
-      if (hierarchy.members.empty()) return;
-      const auto& top = hierarchy.members.back();
-      for (std::size_t m = 0; m + 1 < top.size(); ++m) {
+  const bool odometry_boundaries =
+      options.boundary_sigma_m > 0.0 && options.boundary_sigma_rad > 0.0;
+  auto add_boundaries = [&](const auto& hierarchy, const BoundaryLinks& registered,
+                            const std::vector<Isometry3d>& odometry, std::size_t first_var) {
+    if (hierarchy.members.empty()) return;
+    const auto& top = hierarchy.members.back();
+    for (std::size_t m = 0; m + 1 < top.size(); ++m) {
+      if (m < registered.size() && registered[m]) {
+        const CrossLink& l = *registered[m];
+        add_relative(first_var + l.frame_a, first_var + l.frame_b, l.measured, l.information,
+                     options.link_huber, 3);
+        ++st.boundary_links;
+      } else if (odometry_boundaries) {
         const std::size_t from = top[m].end - 1, to = top[m + 1].begin;
+        const Mat6d sqrt_info =
+            isotropic_sqrt_information(options.boundary_sigma_m, options.boundary_sigma_rad);
         add_relative(first_var + from, first_var + to, odometry[from].inverse() * odometry[to],
                      Mat6d(sqrt_info.transpose() * sqrt_info), 0.0, 3);
-        ++st.boundary_factors;
+      } else {
+        continue;
       }
-    };
-    add_boundaries(ha, poses_a, 0);
-    add_boundaries(hb, poses_b, na);
-  }
+      ++st.boundary_factors;
+    }
+  };
+  add_boundaries(ha, boundary_a, poses_a, 0);
+  add_boundaries(hb, boundary_b, poses_b, na);
   const std::size_t first_tie = graph.factors.size();
   const Mat6d tie_sqrt =
       isotropic_sqrt_information(options.extrinsic_sigma_m, options.extrinsic_sigma_rad);

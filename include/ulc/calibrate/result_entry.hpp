@@ -129,6 +129,7 @@ inline io::Json hots_to_json(const HotsReport& h) {
   j["cross_links_attempted"] = s.cross_links_attempted;
   j["extrinsic_ties"] = s.extrinsic_ties;
   j["boundary_factors"] = s.boundary_factors;
+  j["boundary_links"] = s.boundary_links;
   j["graph_iterations"] = s.graph_iterations;
   j["graph_initial_cost"] = s.graph_initial_cost;
   j["graph_cost"] = s.graph_cost;
