@@ -11,8 +11,9 @@
 //   HOTS positions and each one's frame-to-frame motion error (to see where a drift comes from).
 //   --hots NAME=VALUE (repeatable): one of HOTS's numeric options by name, for experiments
 //   without a rebuild: plane_voxel, plane_depth, plane_ratio, plane_distance, frame_voxel,
-//   submap_voxel, boundary_registration (0/1), boundary_sigma_m, boundary_sigma_rad,
-//   extrinsic_sigma_m, extrinsic_sigma_rad, link_min_layer, rounds, window, synchronise_time (0/1).
+//   submap_voxel, boundary_registration (0/1), boundary_radius_m, boundary_sigma_m,
+//   boundary_sigma_rad, extrinsic_sigma_m, extrinsic_sigma_rad, link_min_layer, rounds, window,
+//   synchronise_time (0/1).
 //   --deskew-from-base: the whole-sequence step reads b's frames deskewed afresh with the
 //   base's refined trajectory (SequenceExtrinsicOptions::deskew_from_base) instead of b's own
 //   odometry.
@@ -98,6 +99,7 @@ void apply_hots_setting(hots::RefineOptions& o, const std::string& setting) {
       {"frame_voxel", [&] { o.frame_voxel = v; }},
       {"submap_voxel", [&] { o.hierarchy.submap_voxel = v; }},
       {"boundary_registration", [&] { o.boundary_registration = v != 0.0; }},
+      {"boundary_radius_m", [&] { o.boundary_radius_m = v; }},
       {"boundary_sigma_m", [&] { o.boundary_sigma_m = v; }},
       {"boundary_sigma_rad", [&] { o.boundary_sigma_rad = v; }},
       {"extrinsic_sigma_m", [&] { o.extrinsic_sigma_m = v; }},
@@ -227,6 +229,7 @@ struct Run {
   double ate_aligned_odometry = 0.0, ate_aligned_hots = 0.0;
   std::string rpe;  ///< rpe_line of odometry and HOTS
   hots::SequenceExtrinsicResult sequence;
+  std::string links;  ///< "cross k/n, boundaries k/n": HOTS's registrations kept
   double sequence_s = 0.0;
   double odometry_s = 0.0, hots_s = 0.0;
   double true_offset_s = 0.0, hots_offset_s = 0.0;
@@ -287,6 +290,10 @@ Run one_run(const std::string& scenario, double offset_s, std::size_t run, const
     out.status = std::string("hots_") + hots::to_string(h.status);
     out.hots_ok = h.ok();
     out.sequence = h.statistics.sequence;  // the trust check's figures, whatever the status
+    const auto& st = h.statistics;
+    out.links = "cross " + std::to_string(st.cross_links) + "/" +
+                std::to_string(st.cross_links_attempted) + ", boundaries " +
+                std::to_string(st.boundary_links) + "/" + std::to_string(st.boundary_factors);
     if (!h.ok()) return;
     out.hots_error = ulc::pose_error(truth, h.extrinsic);
     out.dt_error_s = h.time_offset_s - true_offset;
@@ -402,8 +409,9 @@ void bench(Config c) {
                     << r.dt_error_s * 1e3 << " ms, ATE " << r.ate_odometry * 100 << " -> "
                     << r.ate_hots * 100 << " cm (aligned " << r.ate_aligned_odometry * 100 << " -> "
                     << r.ate_aligned_hots * 100 << " cm) (" << r.odometry_s << " + " << r.hots_s
-                    << " s); sequence: joint dt " << r.sequence.joint_time_offset_s * 1e3
-                    << " ms sigma " << r.sequence.time_sigma_s * 1e3 << " ms observability "
+                    << " s); links " << r.links << "; sequence: joint dt "
+                    << r.sequence.joint_time_offset_s * 1e3 << " ms sigma "
+                    << r.sequence.time_sigma_s * 1e3 << " ms observability "
                     << r.sequence.time_observability << " adopted "
                     << r.sequence.time_offset_refined << " halves "
                     << r.sequence.half_time_offset_s[0] * 1e3 << ", "

@@ -10,10 +10,12 @@
 // fails with time_offset_untrusted.
 //
 // Per target: e_rot (deg) and e_trans (cm) against the simulator's mounts, the calibration's
-// status, the route, the clock offset error when HOTS ran, the wall time of its calibrations
-// (direct + routed); "bar" is issue 7's: e_rot < 0.1 deg and e_trans < 2 cm (and status ok).
-// Per cycle: the closure error of T_base_i * T_i_j * T_base_j^-1 and the i -> j status and time.
-// One run per scenario (seed --seed): the figures are single measurements, not medians.
+// status, the route, the clock offset error when HOTS ran, the cross links of the kept result
+// (agreeing with the extrinsic / kept / attempted: HOTS's trust rule, include/hots/hots.hpp),
+// the wall time of its calibrations (direct + routed); "bar" is issue 7's: e_rot < 0.1 deg and
+// e_trans < 2 cm (and status ok). Per cycle: the closure error of T_base_i * T_i_j * T_base_j^-1
+// and the i -> j status and time. One run per scenario (seed --seed): the figures are single
+// measurements, not medians.
 #include <tbb/task_arena.h>
 #include <chrono>
 #include <cmath>
@@ -56,7 +58,7 @@ void bench(const Config& c) {
     std::exit(2);
   }
   ulc_bench::Table targets({"scenario", "base", "target", "status", "route", "e_rot_deg",
-                            "e_trans_cm", "dt_error_ms", "bar", "time_s"});
+                            "e_trans_cm", "dt_error_ms", "cross_links", "bar", "time_s"});
   ulc_bench::Table cycles(
       {"scenario", "cycle", "status", "closure_rot_deg", "closure_trans_cm", "time_s"});
   tbb::task_arena arena(c.threads);
@@ -114,11 +116,19 @@ void bench(const Config& c) {
       // t_base = t_target + offset; each LiDAR's own clock is t_true - clock_offset.
       const double true_offset = lidar.clock_offset_s - base.clock_offset_s;
       const bool bar = t.ok() && e.rotation_deg < 0.1 && e.translation_m < 0.02;
+      // HOTS's trust evidence (agreeing/kept/attempted cross links), whatever its status; "-"
+      // when it did not run.
+      const auto& h = t.result.hots;
+      const Cell links = h && h->statistics.cross_links_attempted > 0
+                             ? Cell(std::to_string(h->statistics.cross_links_agreeing) + "/" +
+                                    std::to_string(h->statistics.cross_links) + "/" +
+                                    std::to_string(h->statistics.cross_links_attempted))
+                             : Cell("-");
       targets.add_row(
           {name, rig.base_name, t.name, ulc::to_string(t.result.status),
            t.routed() ? "via " + t.via_name : std::string("direct"), Cell::num(e.rotation_deg, 4),
            Cell::num(100.0 * e.translation_m, 2),
-           hots_ran ? Cell::num(1e3 * (t.result.time_offset_s - true_offset), 2) : Cell("-"),
+           hots_ran ? Cell::num(1e3 * (t.result.time_offset_s - true_offset), 2) : Cell("-"), links,
            bar ? "yes" : "no", Cell::num(t.result.timing_s.total, 1)});
     }
     for (const ulc::RigCycle& cy : rig.cycles) {

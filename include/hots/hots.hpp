@@ -42,6 +42,17 @@
 //     status is time_offset_untrusted and reason says why: the extrinsic absorbs v * (the
 //     offset's error), so the result cannot be trusted. A caller who knows the offset turns
 //     the synchronisation off and passes it as time_offset_s.
+//   - The extrinsic must be confirmed by the LiDARs' own views: the cross links register b's
+//     submaps to a's from the prediction of the starting extrinsic, and a kept link agrees
+//     with it when the registration moved less than 1 deg and 1 m from that start
+//     (cross_links.hpp). When fewer than max(min_cross_links, min_cross_link_ratio *
+//     attempted) links agree, the status is extrinsic_unconfirmed (checked before the clock
+//     offset's trust). The graph cannot repair such a start: its ties hold C where it began
+//     and a planar drive leaves the two trajectories' consistency degenerate. Measured
+//     (bench_trust and the seven-LiDAR rig, docs/BENCHMARKS.md "Cross links as the
+//     extrinsic's evidence"): wrong extrinsics JEEP accepted had 0-1 agreeing links of 90
+//     (64-tele, horizon-tele) and 0 of 538 (the rig's Tele, whose 27 kept links all moved
+//     1.6-14.8 deg); right ones on the Tele pairs at least 8 of 90 and 35 of 538.
 //   - Nothing here throws or prints; results are the same for any number of threads.
 #pragma once
 
@@ -84,8 +95,14 @@ struct RefineOptions {
   /// step across the boundary (last frame of a submap to the first of the next) becomes a
   /// factor with these standard deviations. sigma <= 0 and no registration: no boundary factors.
   bool boundary_registration = true;
+  /// m, the boundary registration's crop around the boundary (boundary_links.hpp); 0: none.
+  double boundary_radius_m = 0.0;
   double boundary_sigma_m = 0.02;
   double boundary_sigma_rad = 0.002;
+  /// Trust (see the conventions): agreeing cross links >= max(min_cross_links,
+  /// min_cross_link_ratio * attempted); min_cross_link_ratio <= 0 turns the check off.
+  double min_cross_link_ratio = 0.03;
+  std::size_t min_cross_links = 3;
   double time_offset_s = 0.0;  ///< initial clock offset estimate (centre of the search)
   bool synchronise_time = true;
   TimeSyncOptions time_sync;  ///< centre_s is replaced by time_offset_s
@@ -101,7 +118,8 @@ enum class RefineStatus {
   graph_failed,
   time_sync_failed,
   sequence_failed,
-  time_offset_untrusted  ///< the drive does not pin the clock offset down (see reason)
+  time_offset_untrusted,  ///< the drive does not pin the clock offset down (see reason)
+  extrinsic_unconfirmed   ///< too few cross links: the LiDARs' views do not confirm C
 };
 
 inline const char* to_string(RefineStatus s) {
@@ -116,6 +134,8 @@ inline const char* to_string(RefineStatus s) {
       return "sequence_failed";
     case RefineStatus::time_offset_untrusted:
       return "time_offset_untrusted";
+    case RefineStatus::extrinsic_unconfirmed:
+      return "extrinsic_unconfirmed";
     default:
       return "time_sync_failed";
   }
@@ -124,8 +144,9 @@ inline const char* to_string(RefineStatus s) {
 struct RefineStatistics {
   std::size_t windows = 0, failed_windows = 0, planes = 0;
   std::size_t ba_factors = 0, cross_links = 0, cross_links_attempted = 0, extrinsic_ties = 0;
-  std::size_t boundary_factors = 0;  ///< top-layer submap boundaries tied in the graph
-  std::size_t boundary_links = 0;    ///< of those, by registering the submaps (the rest: odometry)
+  std::size_t cross_links_agreeing = 0;  ///< kept links that confirm the start (cross_links.hpp)
+  std::size_t boundary_factors = 0;      ///< top-layer submap boundaries tied in the graph
+  std::size_t boundary_links = 0;  ///< of those, by registering the submaps (the rest: odometry)
   double graph_initial_cost = 0.0, graph_cost = 0.0;
   int graph_iterations = 0;
   double time_sync_spread = 0.0;
@@ -156,6 +177,15 @@ struct RefineResult {
 };
 
 namespace hots_detail {
+
+/// The trust rule on the cross links (see the conventions); no attempt: nothing to judge.
+inline bool links_confirm(const RefineStatistics& st, const RefineOptions& options) {
+  if (!(options.min_cross_link_ratio > 0.0) || st.cross_links_attempted == 0) return true;
+  const double needed =
+      std::max(static_cast<double>(options.min_cross_links),
+               options.min_cross_link_ratio * static_cast<double>(st.cross_links_attempted));
+  return static_cast<double>(st.cross_links_agreeing) >= needed;
+}
 
 /// Seconds since `start`, and `start` moved to now: consecutive phases of one run.
 inline double lap(std::chrono::steady_clock::time_point& start) {
@@ -303,13 +333,16 @@ RefineResult refine(const FramesA& frames_a, const std::vector<double>& times_a,
                                  options.time_offset_s, options.links, &link_stats);
   st.cross_links = links.size();
   st.cross_links_attempted = link_stats.attempted;
+  st.cross_links_agreeing = link_stats.agreeing;
   using BoundaryLinks = std::vector<std::optional<CrossLink>>;
-  const BoundaryLinks boundary_a = options.boundary_registration
-                                       ? boundary_links(ha, fa, world_a, options.links)
-                                       : BoundaryLinks{};
-  const BoundaryLinks boundary_b = options.boundary_registration
-                                       ? boundary_links(hb, fb, world_b, options.links)
-                                       : BoundaryLinks{};
+  const BoundaryLinks boundary_a =
+      options.boundary_registration
+          ? boundary_links(ha, fa, world_a, options.links, options.boundary_radius_m)
+          : BoundaryLinks{};
+  const BoundaryLinks boundary_b =
+      options.boundary_registration
+          ? boundary_links(hb, fb, world_b, options.links, options.boundary_radius_m)
+          : BoundaryLinks{};
   st.links_seconds = d::lap(clock);
 
   const std::size_t na = frames_a.size(), nb = frames_b.size();
@@ -454,6 +487,11 @@ RefineResult refine(const FramesA& frames_a, const std::vector<double>& times_a,
   const Isometry3d mapb_mapa = mapa_mapb.inverse();
   for (std::size_t i = 0; i < na; ++i) result.poses_a[i] = graph.variables[i];
   for (std::size_t j = 0; j < nb; ++j) result.poses_b[j] = mapb_mapa * graph.variables[na + j];
+  if (!hots_detail::links_confirm(st, options))
+    return fail(RefineStatus::extrinsic_unconfirmed,
+                "too few of the cross links (b's submaps registered to a's through the "
+                "extrinsic) agree with it: the two LiDARs' views do not confirm the extrinsic "
+                "(statistics: cross_links_agreeing of cross_links_attempted)");
   if (!st.sequence.time_offset_trusted)
     return fail(RefineStatus::time_offset_untrusted, st.sequence.time_offset_doubt);
   return result;

@@ -421,6 +421,12 @@ PairCalibration calibrate_pair(const FramesA& frames_a, const std::vector<double
     if (!h.ok())
       return finish(CalibrateStatus::hots_failed,
                     std::string("HOTS: ") + hots::to_string(h.status) + ": " + h.reason +
+                        (h.status == hots::RefineStatus::extrinsic_unconfirmed
+                             ? "; " + std::to_string(h.statistics.cross_links_agreeing) + " of " +
+                                   std::to_string(h.statistics.cross_links_attempted) +
+                                   " agree: the extrinsic before HOTS is likely wrong (TERRA's "
+                                   "rotation or the initial guess)"
+                             : std::string()) +
                         (h.status == hots::RefineStatus::time_offset_untrusted
                              ? "; a longer drive with turns and speed changes pins it down, "
                                "and synchronised clocks are said so with time_offset_s = 0 "

@@ -45,6 +45,8 @@ TEST_CASE("refine improves a disturbed extrinsic on a simulated 64-32 drive", "[
   // 3 s of driving does not pin a clock offset down: HOTS says so, and still returns what it
   // refined (the offset it kept, the extrinsic, the poses).
   REQUIRE(r.status == hots::RefineStatus::time_offset_untrusted);
+  // The offset is checked after the cross links: a right start keeps enough of them.
+  CHECK(hots::hots_detail::links_confirm(r.statistics, options));
   CHECK(r.statistics.sequence.time_offset_checked);
   CHECK(r.statistics.sequence.time_observability < options.sequence.min_time_observability);
   const auto e0 = ulc::pose_error(C_gt, C0);
@@ -100,6 +102,78 @@ std::vector<ulc::Isometry3d> glitched(std::vector<ulc::Isometry3d> poses, std::s
 }
 
 }  // namespace
+
+TEST_CASE("an extrinsic the LiDARs' views do not confirm is refused", "[hots][refine]") {
+  // A wrong start (as a wrong TERRA rotation that JEEP accepted): b's submaps registered to a's
+  // through it do not agree, so the cross links are dropped and the graph could only follow the
+  // two trajectories, which a planar drive leaves degenerate. HOTS must say so, not answer.
+  const Drive& d = drive();
+  const auto& a = d.data.lidars[0];
+  const auto& b = d.data.lidars[1];
+  const ulc::Isometry3d C_gt = d.data.pairs[0].T_base_target;
+  ulc::Isometry3d wrong = C_gt;
+  wrong.linear() =
+      Eigen::AngleAxisd(30.0 * hots_test::kDeg, ulc::Vec3d::UnitZ()).toRotationMatrix() *
+      C_gt.linear();
+  wrong.translation() += ulc::Vec3d(1.5, -1.0, 0.0);
+  const auto pa = drifting(d.truth_a, a.timestamps, 1);
+  const auto pb = drifting(d.truth_b, b.timestamps, 2);
+  hots::RefineOptions options;
+  const hots::RefineResult r =
+      hots::refine(a.frames, a.timestamps, pa, b.frames, b.timestamps, pb, wrong, options);
+  const auto& st = r.statistics;
+  INFO(hots::to_string(r.status) << ": " << r.reason << "; links " << st.cross_links << "/"
+                                 << st.cross_links_attempted);
+  CHECK(r.status == hots::RefineStatus::extrinsic_unconfirmed);
+  CHECK(st.cross_links_attempted >= options.min_cross_links);
+  CHECK(st.cross_links_agreeing < options.min_cross_links);
+  CHECK(st.cross_links_agreeing <= st.cross_links);
+  // The rule is the statistics' own verdict: off, the same run reaches the next check.
+  options.min_cross_link_ratio = 0.0;
+  const hots::RefineResult unchecked =
+      hots::refine(a.frames, a.timestamps, pa, b.frames, b.timestamps, pb, wrong, options);
+  CHECK(unchecked.status != hots::RefineStatus::extrinsic_unconfirmed);
+  // ... and what it would have returned misses issue 7's bar (0.1 deg, 2 cm) by far.
+  const auto e = ulc::pose_error(C_gt, unchecked.extrinsic);
+  INFO("unchecked: " << e.rotation_deg << " deg " << 100 * e.translation_m << " cm");
+  CHECK((e.rotation_deg > 0.2 || e.translation_m > 0.04));
+}
+
+TEST_CASE("a link records how far its registration moved from the start", "[hots][links]") {
+  // One frame registered to itself from a start 2 deg and 30 cm off: the registration comes
+  // back to the identity, so it moved by the start's own error (what the trust rule reads).
+  const auto& frame = drive().data.lidars[0].frames.at(0);
+  const std::vector<ulc::Vec3<float>> cloud(frame.points.begin(), frame.points.end());
+  ulc::Isometry3d start = ulc::Isometry3d::Identity();
+  start.linear() = Eigen::AngleAxisd(2.0 * hots_test::kDeg, ulc::Vec3d(0.3, 0.2, 1.0).normalized())
+                       .toRotationMatrix();
+  start.translation() = ulc::Vec3d(0.24, -0.18, 0.0);
+  const hots::CrossLinkOptions options;
+  const auto link =
+      hots::register_clouds(cloud, cloud, start, options, ulc::coarse_to_fine_stages(options.gate));
+  REQUIRE(link);
+  const auto e = ulc::pose_error(ulc::Isometry3d::Identity(), link->measured);
+  INFO("registered to " << e.rotation_deg << " deg " << 100 * e.translation_m << " cm");
+  CHECK(e.rotation_deg < 0.05);
+  CHECK(e.translation_m < 0.01);
+  CHECK(link->moved_rad / hots_test::kDeg == Approx(2.0).margin(0.05));
+  CHECK(link->moved_m == Approx(0.30).margin(0.01));
+}
+
+TEST_CASE("the boundary crop keeps the points within the radius, or all of them",
+          "[hots][boundary]") {
+  const std::vector<ulc::Vec3<float>> cloud{{0, 0, 0}, {3, 4, 0}, {5.5f, 0, 0}, {-1, -1, -1}};
+  const ulc::Vec3d centre(1, 0, 0);
+  // Distances from the centre: 1, sqrt(20) = 4.47, 4.5, sqrt(6) = 2.45.
+  const auto kept = hots::boundary_detail::within(cloud, centre, 4.48);
+  REQUIRE(kept.size() == 3);
+  CHECK(kept[0] == cloud[0]);
+  CHECK(kept[1] == cloud[1]);
+  CHECK(kept[2] == cloud[3]);
+  CHECK(hots::boundary_detail::within(cloud, centre, 4.4).size() == 2);
+  CHECK(hots::boundary_detail::within(cloud, centre, 4.6).size() == 4);
+  CHECK(hots::boundary_detail::within(cloud, centre, 0.0).size() == cloud.size());
+}
 
 TEST_CASE("the top layer's submaps are tied together", "[hots][refine]") {
   // Without boundary factors each submap keeps its first frame where the drifting odometry

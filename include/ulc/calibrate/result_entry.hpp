@@ -127,6 +127,7 @@ inline io::Json hots_to_json(const HotsReport& h) {
   j["ba_factors"] = s.ba_factors;
   j["cross_links"] = s.cross_links;
   j["cross_links_attempted"] = s.cross_links_attempted;
+  j["cross_links_agreeing"] = s.cross_links_agreeing;
   j["extrinsic_ties"] = s.extrinsic_ties;
   j["boundary_factors"] = s.boundary_factors;
   j["boundary_links"] = s.boundary_links;
