@@ -54,6 +54,7 @@
 #include "../tests/jeep/jeep_test_util.hpp"
 #include "hots/hots.hpp"
 #include "jeep/run_odometry.hpp"
+#include "support/bench_args.hpp"
 #include "support/bench_util.hpp"
 #include "support/curve_png.hpp"
 #include "ulc/calibrate.hpp"
@@ -474,46 +475,26 @@ void bench(Config c) {
 
 int main(int argc, char** argv) {
   Config c;
-  std::vector<char*> rest = {argv[0]};
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    const bool value = i + 1 < argc;
-    if (a == "--accuracy" || a == "--time-offset") {
-      c.mode = a.substr(2);
-    } else if (a == "--scenarios" && value) {
-      c.scenarios = ulc_bench::split_list(argv[++i]);
-    } else if (a == "--seconds" && value) {
-      c.seconds = std::atof(argv[++i]);
-    } else if (a == "--runs" && value) {
-      c.runs = std::max<std::size_t>(1, std::strtoul(argv[++i], nullptr, 10));
-    } else if (a == "--first-run" && value) {
-      c.first_run = std::strtoul(argv[++i], nullptr, 10);
-    } else if (a == "--decimation" && value) {
-      c.decimation = static_cast<unsigned>(std::max(1, std::atoi(argv[++i])));
-    } else if (a == "--threads" && value) {
-      c.threads = std::max(1, std::atoi(argv[++i]));
-    } else if (a == "--spread-png" && value) {
-      c.spread_png = argv[++i];
-    } else if (a == "--pre-shift-ms" && value) {
-      c.pre_shift_s = std::atof(argv[++i]) * 1e-3;
-    } else if (a == "--layers" && value) {
-      c.layers = std::max(1, std::atoi(argv[++i]));
-    } else if (a == "--trajectory" && value) {
-      c.trajectory = argv[++i];
-    } else if (a == "--hots" && value) {
-      c.hots_settings.push_back(argv[++i]);
-    } else if (a == "--no-traffic") {
-      c.no_traffic = true;
-    } else if (a == "--deskew-from-base") {
-      c.deskew_from_base = true;
-    } else {
-      rest.push_back(argv[i]);
-    }
-  }
-  c.bench = ulc_bench::parse_options(static_cast<int>(rest.size()), rest.data(),
-                                     "HOTS after JEEP on simulated drives (modes: --accuracy "
-                                     "--time-offset; options --scenarios --seconds --runs "
-                                     "--first-run --decimation --threads --spread-png)");
+  ulc_bench::Args args;
+  args.flag("--accuracy", [&] { c.mode = "accuracy"; })
+      .flag("--time-offset", [&] { c.mode = "time-offset"; })
+      .value("--scenarios", ulc_bench::list(c.scenarios))
+      .value("--seconds", ulc_bench::number(c.seconds))
+      .value("--runs", ulc_bench::at_least(c.runs, std::size_t{1}))
+      .value("--first-run", ulc_bench::at_least(c.first_run, std::size_t{0}))
+      .value("--decimation", ulc_bench::at_least(c.decimation, 1u))
+      .value("--threads", ulc_bench::at_least(c.threads, 1))
+      .value("--spread-png", ulc_bench::text(c.spread_png))
+      .value("--pre-shift-ms", ulc_bench::number(c.pre_shift_s, 1e-3))
+      .value("--layers", ulc_bench::at_least(c.layers, 1))
+      .value("--trajectory", ulc_bench::text(c.trajectory))
+      .value("--hots", ulc_bench::append(c.hots_settings))
+      .flag("--no-traffic", [&] { c.no_traffic = true; })
+      .flag("--deskew-from-base", [&] { c.deskew_from_base = true; });
+  c.bench = args.parse(argc, argv,
+                       "HOTS after JEEP on simulated drives (modes: --accuracy --time-offset; "
+                       "options --scenarios --seconds --runs --first-run --decimation --threads "
+                       "--spread-png)");
   bench(c);
   return 0;
 }

@@ -42,6 +42,7 @@
 #include "jeep/jeep.hpp"
 #include "jeep/run_odometry.hpp"
 #include "jeep/scan_scan.hpp"
+#include "support/bench_args.hpp"
 #include "support/bench_util.hpp"
 #include "support/heatmap_png.hpp"
 #include "ulc/core/pose_error.hpp"
@@ -589,41 +590,24 @@ void registration(Config c) {
 
 int main(int argc, char** argv) {
   Config c;
-  std::vector<char*> rest = {argv[0]};
-  bool repeats_given = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    const bool value = i + 1 < argc;
-    repeats_given = repeats_given || a == "--repeats";
-    if (a == "--accuracy" || a == "--separation" || a == "--robustness" || a == "--odometry" ||
-        a == "--frames-sweep" || a == "--registration") {
-      c.mode = a.substr(2);
-    } else if (a == "--scenarios" && value) {
-      c.scenarios = ulc_bench::split_list(argv[++i]);
-    } else if (a == "--starts" && value) {
-      c.starts = std::max<std::size_t>(1, std::strtoul(argv[++i], nullptr, 10));
-    } else if (a == "--frames" && value) {
-      c.frames = std::max<std::size_t>(1, std::strtoul(argv[++i], nullptr, 10));
-    } else if (a == "--seconds" && value) {
-      c.seconds = std::atof(argv[++i]);
-    } else if (a == "--seed" && value) {
-      c.seed = std::strtoull(argv[++i], nullptr, 10);
-    } else if (a == "--threads" && value) {
-      c.threads = std::max(1, std::atoi(argv[++i]));
-    } else if (a == "--cache" && value) {
-      c.cache = argv[++i];
-    } else if (a == "--png" && value) {
-      c.png_dir = argv[++i];
-    } else if (a == "--one-way") {
-      c.one_way = true;
-    } else {
-      rest.push_back(argv[i]);
-    }
-  }
-  c.bench = ulc_bench::parse_options(static_cast<int>(rest.size()), rest.data(),
-                                     "JEEP, scan-scan, odometry and ICP on simulated drives "
-                                     "(modes: --accuracy --separation --robustness "
-                                     "--frames-sweep --odometry --registration)");
+  const bool repeats_given = std::any_of(
+      argv + 1, argv + argc, [](const char* a) { return std::string(a) == "--repeats"; });
+  ulc_bench::Args args;
+  for (const char* mode :
+       {"accuracy", "separation", "robustness", "odometry", "frames-sweep", "registration"})
+    args.flag(std::string("--") + mode, [&c, mode] { c.mode = mode; });
+  args.value("--scenarios", ulc_bench::list(c.scenarios))
+      .value("--starts", ulc_bench::at_least(c.starts, std::size_t{1}))
+      .value("--frames", ulc_bench::at_least(c.frames, std::size_t{1}))
+      .value("--seconds", ulc_bench::number(c.seconds))
+      .value("--seed", ulc_bench::at_least(c.seed, std::uint64_t{0}))
+      .value("--threads", ulc_bench::at_least(c.threads, 1))
+      .value("--cache", ulc_bench::text(c.cache))
+      .value("--png", ulc_bench::text(c.png_dir))
+      .flag("--one-way", [&] { c.one_way = true; });
+  c.bench = args.parse(argc, argv,
+                       "JEEP, scan-scan, odometry and ICP on simulated drives (modes: --accuracy "
+                       "--separation --robustness --frames-sweep --odometry --registration)");
   if (c.mode == "accuracy") {
     accuracy(c);
   } else if (c.mode == "separation") {

@@ -25,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "support/bench_args.hpp"
 #include "support/bench_util.hpp"
 #include "ulc/calibrate/rig.hpp"
 #include "ulc/core/pose_error.hpp"
@@ -175,36 +176,19 @@ void bench(const Config& c) {
 
 int main(int argc, char** argv) {
   Config c;
-  std::vector<char*> rest = {argv[0]};
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    const bool value = i + 1 < argc;
-    if (a == "--scenarios" && value) {
-      c.scenarios = ulc_bench::split_list(argv[++i]);
-    } else if (a == "--seconds" && value) {
-      c.seconds = std::atof(argv[++i]);
-    } else if (a == "--stages" && value) {
-      c.stages = argv[++i];
-    } else if (a == "--decimation" && value) {
-      c.decimation = static_cast<unsigned>(std::max(1, std::atoi(argv[++i])));
-    } else if (a == "--seed" && value) {
-      c.seed = std::strtoull(argv[++i], nullptr, 10);
-    } else if (a == "--threads" && value) {
-      c.threads = std::max(1, std::atoi(argv[++i]));
-    } else if (a == "--no-route") {
-      c.route = false;
-    } else if (a == "--no-cycles") {
-      c.cycles = false;
-    } else if (a == "--synced-clocks") {
-      c.synced_clocks = true;
-    } else {
-      rest.push_back(argv[i]);
-    }
-  }
-  c.bench = ulc_bench::parse_options(static_cast<int>(rest.size()), rest.data(),
-                                     "whole rigs with no initial guess (options --scenarios "
-                                     "--seconds --stages --decimation --seed --threads "
-                                     "--no-route --no-cycles --synced-clocks)");
+  ulc_bench::Args args;
+  args.value("--scenarios", ulc_bench::list(c.scenarios))
+      .value("--seconds", ulc_bench::number(c.seconds))
+      .value("--stages", ulc_bench::text(c.stages))
+      .value("--decimation", ulc_bench::at_least(c.decimation, 1u))
+      .value("--seed", ulc_bench::at_least(c.seed, std::uint64_t{0}))
+      .value("--threads", ulc_bench::at_least(c.threads, 1))
+      .flag("--no-route", [&] { c.route = false; })
+      .flag("--no-cycles", [&] { c.cycles = false; })
+      .flag("--synced-clocks", [&] { c.synced_clocks = true; });
+  c.bench = args.parse(argc, argv,
+                       "whole rigs with no initial guess (options --scenarios --seconds --stages "
+                       "--decimation --seed --threads --no-route --no-cycles --synced-clocks)");
   bench(c);
   return 0;
 }

@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "support/bench_args.hpp"
 #include "support/bench_util.hpp"
 #include "ulc/sim/dataset_writer.hpp"
 #include "ulc/sim/simulate.hpp"
@@ -100,24 +101,16 @@ std::pair<double, double> wall_and_cpu(int repeats, F&& f) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  // Our own options first; the rest goes to the shared parser.
   double seconds = 20.0;
   fs::path out_dir;
-  bool repeats_given = false;
-  std::vector<char*> rest = {argv[0]};
-  for (int i = 1; i < argc; ++i) {
-    if (std::strcmp(argv[i], "--seconds") == 0 && i + 1 < argc) {
-      seconds = std::atof(argv[++i]);
-    } else if (std::strcmp(argv[i], "--out") == 0 && i + 1 < argc) {
-      out_dir = argv[++i];
-    } else {
-      repeats_given = repeats_given || std::strcmp(argv[i], "--repeats") == 0;
-      rest.push_back(argv[i]);
-    }
-  }
-  ulc_bench::Options options = ulc_bench::parse_options(
-      static_cast<int>(rest.size()), rest.data(),
-      "simulator speed: scenario 64-32 generated and written (--seconds S, --out DIR)");
+  const bool repeats_given = std::any_of(
+      argv + 1, argv + argc, [](const char* a) { return std::strcmp(a, "--repeats") == 0; });
+  ulc_bench::Args args;
+  args.value("--seconds", ulc_bench::number(seconds)).value("--out", [&](const char* s) {
+    out_dir = s;
+  });
+  ulc_bench::Options options = args.parse(
+      argc, argv, "simulator speed: scenario 64-32 generated and written (--seconds S, --out DIR)");
   if (!repeats_given) options.repeats = 3;
   const bool remove_out = out_dir.empty();
   if (out_dir.empty()) out_dir = fs::temp_directory_path() / "ulc_bench_sim";

@@ -39,6 +39,7 @@
 #include <vector>
 
 #include "../tests/terra/terra_test_util.hpp"
+#include "support/bench_args.hpp"
 #include "support/bench_util.hpp"
 #include "terra/terra.hpp"
 #include "ulc/calibrate.hpp"
@@ -656,62 +657,39 @@ int run_maps(const ulc_bench::Options& options, const MapsOptions& mo) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  // Our own options first; the rest go to the shared parser.
   bool accuracy = false, maps = false;
   AccuracyOptions acc;
   MapsOptions mo;
   bool pairs_given = false;
-  std::vector<char*> rest = {argv[0]};
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    const bool has_value = i + 1 < argc;
-    if (a == "--accuracy") {
-      accuracy = true;
-    } else if (a == "--maps") {
-      maps = true;
-    } else if (a == "--starts" && has_value) {
-      mo.starts = std::max<std::size_t>(1, std::strtoul(argv[++i], nullptr, 10));
-    } else if (a == "--spacing" && has_value) {
-      mo.spacing_s = std::atof(argv[++i]);
-    } else if (a == "--window" && has_value) {
-      mo.window_s = std::atof(argv[++i]);
-    } else if (a == "--decimation" && has_value) {
-      mo.decimation = unsigned(std::max(1, std::atoi(argv[++i])));
-    } else if (a == "--below-mask" && has_value) {
-      mo.below_mask = std::strtoul(argv[++i], nullptr, 10);
-    } else if (a == "--pairs" && has_value) {
-      acc.pairs = ulc_bench::split_list(argv[++i]);
-      pairs_given = true;
-    } else if (a == "--samples" && has_value) {
-      acc.samples = std::max<std::size_t>(1, std::strtoul(argv[++i], nullptr, 10));
-    } else if (a == "--seed" && has_value) {
-      acc.seed = std::strtoull(argv[++i], nullptr, 10);
-    } else if (a == "--lattice" && has_value) {
-      acc.lattice = std::max<std::size_t>(2, std::strtoul(argv[++i], nullptr, 10));
-    } else if (a == "--adaptive-d1") {
-      acc.adaptive_d1 = true;
-    } else if (a == "--no-adaptive-d1") {
-      acc.adaptive_d1 = false;
-    } else if (a == "--min-overlap" && has_value) {
-      acc.min_overlap = std::atof(argv[++i]);
-    } else if (a == "--top-k" && has_value) {
-      acc.top_k = std::max<std::size_t>(1, std::strtoul(argv[++i], nullptr, 10));
-    } else if (a == "--d1" && has_value) {
-      acc.distance.d1 = std::atof(argv[++i]);
-    } else if (a == "--d2" && has_value) {
-      acc.distance.d2 = std::atof(argv[++i]);
-    } else if (a == "--alpha" && has_value) {
-      acc.distance.alpha = std::atof(argv[++i]);
-    } else if (a == "--coarse-stride" && has_value) {
-      acc.coarse_stride_deg = std::atof(argv[++i]);
-    } else if (a == "--threads" && has_value) {
-      acc.threads = std::max(1, std::atoi(argv[++i]));
-    } else {
-      rest.push_back(argv[i]);
-    }
-  }
-  const ulc_bench::Options options = ulc_bench::parse_options(
-      static_cast<int>(rest.size()), rest.data(),
+  using ulc_bench::at_least;
+  using ulc_bench::number;
+  ulc_bench::Args args;
+  args.flag("--accuracy", [&] { accuracy = true; })
+      .flag("--maps", [&] { maps = true; })
+      .value("--starts", at_least(mo.starts, std::size_t{1}))
+      .value("--spacing", number(mo.spacing_s))
+      .value("--window", number(mo.window_s))
+      .value("--decimation", at_least(mo.decimation, 1u))
+      .value("--below-mask", at_least(mo.below_mask, std::size_t{0}))
+      .value("--pairs",
+             [&](const char* s) {
+               acc.pairs = ulc_bench::split_list(s);
+               pairs_given = true;
+             })
+      .value("--samples", at_least(acc.samples, std::size_t{1}))
+      .value("--seed", at_least(acc.seed, decltype(acc.seed){0}))
+      .value("--lattice", at_least(acc.lattice, std::size_t{2}))
+      .flag("--adaptive-d1", [&] { acc.adaptive_d1 = true; })
+      .flag("--no-adaptive-d1", [&] { acc.adaptive_d1 = false; })
+      .value("--min-overlap", number(acc.min_overlap))
+      .value("--top-k", at_least(acc.top_k, std::size_t{1}))
+      .value("--d1", number(acc.distance.d1))
+      .value("--d2", number(acc.distance.d2))
+      .value("--alpha", number(acc.distance.alpha))
+      .value("--coarse-stride", number(acc.coarse_stride_deg))
+      .value("--threads", at_least(acc.threads, 1));
+  const ulc_bench::Options options = args.parse(
+      argc, argv,
       "TERRA speed (default) or accuracy against scancontext* (--accuracy [--pairs a,b] "
       "[--samples 50] [--seed 1] [--lattice 10000] [--[no-]adaptive-d1] [--min-overlap 0.2] "
       "[--threads 2]) or frames vs local maps (--maps [--pairs ...] [--starts 8] [--spacing 3] "

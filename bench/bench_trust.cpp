@@ -26,6 +26,7 @@
 #include "../tests/jeep/jeep_test_util.hpp"
 #include "hots/hots.hpp"
 #include "jeep/run_odometry.hpp"
+#include "support/bench_args.hpp"
 #include "support/bench_util.hpp"
 #include "ulc/calibrate.hpp"
 #include "ulc/core/pose_error.hpp"
@@ -184,28 +185,15 @@ void bench(const Config& c) {
 
 int main(int argc, char** argv) {
   Config c;
-  std::vector<char*> rest = {argv[0]};
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    const bool value = i + 1 < argc;
-    if (a == "--scenarios" && value) {
-      c.scenarios = ulc_bench::split_list(argv[++i]);
-    } else if (a == "--seconds" && value) {
-      c.seconds = std::atof(argv[++i]);
-    } else if (a == "--runs" && value) {
-      c.runs = std::max<std::size_t>(1, std::strtoul(argv[++i], nullptr, 10));
-    } else if (a == "--first-run" && value) {
-      c.first_run = std::strtoul(argv[++i], nullptr, 10);
-    } else if (a == "--threads" && value) {
-      c.threads = std::max(1, std::atoi(argv[++i]));
-    } else {
-      rest.push_back(argv[i]);
-    }
-  }
-  c.bench = ulc_bench::parse_options(static_cast<int>(rest.size()), rest.data(),
-                                     "JEEP and HOTS from right and wrong starts: does the "
-                                     "cross-link rule tell them apart (options --scenarios "
-                                     "--seconds --runs --first-run --threads)");
+  ulc_bench::Args args;
+  args.value("--scenarios", ulc_bench::list(c.scenarios))
+      .value("--seconds", ulc_bench::number(c.seconds))
+      .value("--runs", ulc_bench::at_least(c.runs, std::size_t{1}))
+      .value("--first-run", ulc_bench::at_least(c.first_run, std::size_t{0}))
+      .value("--threads", ulc_bench::at_least(c.threads, 1));
+  c.bench = args.parse(argc, argv,
+                       "JEEP and HOTS from right and wrong starts: does the cross-link rule tell "
+                       "them apart (options --scenarios --seconds --runs --first-run --threads)");
   bench(c);
   return 0;
 }
