@@ -4,7 +4,8 @@
 //   bench_hots --accuracy    [--scenarios 64-32,...] [--seconds 60] [--runs 10]
 //   bench_hots --time-offset [--scenarios 64-32,64-horizon] [--seconds 60] [--runs 10]
 //                            [--spread-png PREFIX]
-//   common: [--decimation 1] [--threads 2] [--deskew-from-base] [--first-run 0] [--json]
+//   common: [--decimation 1] [--threads 2] [--deskew-from-base] [--jeep-decides]
+//           [--first-run 0] [--json]
 //           [--layers N] [--trajectory PREFIX] [--hots NAME=VALUE ...]
 //   --layers N: HOTS's hierarchy layers (default: HierarchyOptions' 3, the paper's).
 //   --trajectory PREFIX: per run, PREFIX_<scenario>_run<k>.csv with the base's true, odometry and
@@ -14,6 +15,9 @@
 //   submap_voxel, boundary_registration (0/1), boundary_radius_m, boundary_sigma_m,
 //   boundary_sigma_rad, extrinsic_sigma_m, extrinsic_sigma_rad, link_min_layer, rounds, window,
 //   synchronise_time (0/1).
+//   --jeep-decides: a failed JEEP ends the run (by default, as in the pipeline, a JEEP that was
+//   rejected or did not settle hands its extrinsic to HOTS, whose cross links judge it:
+//   CalibrateOptions::hots_judges_jeep; the stderr line says "judged").
 //   --deskew-from-base: the whole-sequence step reads b's frames deskewed afresh with the
 //   base's refined trajectory (SequenceExtrinsicOptions::deskew_from_base) instead of b's own
 //   odometry.
@@ -77,6 +81,7 @@ struct Config {
   int threads = 2;
   std::string spread_png;         ///< prefix of the spread curve pictures; empty: none
   bool deskew_from_base = false;  ///< --deskew-from-base
+  bool hots_judges_jeep = true;   ///< off with --jeep-decides
   double pre_shift_s = 0.0;       ///< --pre-shift-ms
   bool no_traffic = false;        ///< --no-traffic: the scenario without its oncoming cars
   int layers = 0;                 ///< --layers: HOTS hierarchy layers; 0: the default
@@ -223,6 +228,7 @@ void write_trajectory(const std::string& path, const ulc::sim::Dataset& d,
 
 struct Run {
   bool jeep_ok = false, hots_ok = false;
+  bool judged_by_hots = false;  ///< JEEP failed and HOTS ran from its extrinsic
   std::string status;
   ulc::PoseError jeep_error, hots_error, sync_error;
   double dt_error_s = 0.0, sync_dt_error_s = 0.0;
@@ -274,7 +280,12 @@ Run one_run(const std::string& scenario, double offset_s, std::size_t run, const
     out.jeep_error = ulc::pose_error(truth, C);
     out.hots_error = out.sync_error = out.jeep_error;
     out.dt_error_s = out.sync_dt_error_s = true_offset;
-    if (!j.success) return;
+    // As the pipeline does (CalibrateOptions::hots_judges_jeep): a JEEP that was rejected or
+    // did not settle hands its extrinsic to HOTS, whose cross links judge it.
+    out.judged_by_hots = !j.success && c.hots_judges_jeep && j.jeep &&
+                         (j.jeep->status == "rejected" || j.jeep->status == "not_converged") &&
+                         C.matrix().allFinite();
+    if (!j.success && !out.judged_by_hots) return;
     auto t0 = std::chrono::steady_clock::now();
     const auto odo = jeep::run_odometry(a.frames, a.timestamps, b.frames, times_b, C, o.odometry);
     out.odometry_s = seconds_since(t0);
@@ -402,7 +413,8 @@ void bench(Config c) {
         sh.push_back(r.hots_s);
         if (!c.bench.json)
           std::cerr << "  " << scenario << " offset " << offset * 1e3 << " ms run " << run << ": "
-                    << r.status << "; JEEP " << r.jeep_error.rotation_deg << " deg "
+                    << r.status << (r.judged_by_hots ? " (JEEP failed, judged by HOTS)" : "")
+                    << "; JEEP " << r.jeep_error.rotation_deg << " deg "
                     << r.jeep_error.translation_m * 100 << " cm; sync " << r.sync_error.rotation_deg
                     << " deg " << r.sync_error.translation_m * 100 << " cm dt error "
                     << r.sync_dt_error_s * 1e3 << " ms; HOTS " << r.hots_error.rotation_deg
@@ -490,7 +502,8 @@ int main(int argc, char** argv) {
       .value("--trajectory", ulc_bench::text(c.trajectory))
       .value("--hots", ulc_bench::append(c.hots_settings))
       .flag("--no-traffic", [&] { c.no_traffic = true; })
-      .flag("--deskew-from-base", [&] { c.deskew_from_base = true; });
+      .flag("--deskew-from-base", [&] { c.deskew_from_base = true; })
+      .flag("--jeep-decides", [&] { c.hots_judges_jeep = false; });
   c.bench = args.parse(argc, argv,
                        "HOTS after JEEP on simulated drives (modes: --accuracy --time-offset; "
                        "options --scenarios --seconds --runs --first-run --decimation --threads "

@@ -46,13 +46,14 @@
 //     submaps to a's from the prediction of the starting extrinsic, and a kept link agrees
 //     with it when the registration moved less than 1 deg and 1 m from that start
 //     (cross_links.hpp). When fewer than max(min_cross_links, min_cross_link_ratio *
-//     attempted) links agree, the status is extrinsic_unconfirmed (checked before the clock
-//     offset's trust). The graph cannot repair such a start: its ties hold C where it began
-//     and a planar drive leaves the two trajectories' consistency degenerate. Measured
-//     (bench_trust and the seven-LiDAR rig, docs/BENCHMARKS.md "Cross links as the
-//     extrinsic's evidence"): wrong extrinsics JEEP accepted had 0-1 agreeing links of 90
-//     (64-tele, horizon-tele) and 0 of 538 (the rig's Tele, whose 27 kept links all moved
-//     1.6-14.8 deg); right ones on the Tele pairs at least 8 of 90 and 35 of 538.
+//     attempted) links agree, the status is extrinsic_unconfirmed, decided right after the
+//     links, before the pose graph (the result's extrinsic and poses are then the inputs). The
+//     graph cannot repair such a start: its ties hold C where it began and a planar drive leaves
+//     the two trajectories' consistency degenerate. Measured (bench_trust and the seven-LiDAR rig,
+//     docs/BENCHMARKS.md "Cross links as the extrinsic's evidence"): wrong extrinsics JEEP accepted
+//     had 0-1 agreeing links of 90 (64-tele, horizon-tele) and 0 of 538 (the rig's Tele, whose 27
+//     kept links all moved 1.6-14.8 deg); right ones on the Tele pairs at least 8 of 90 and 35 of
+//     538.
 //   - Nothing here throws or prints; results are the same for any number of threads.
 #pragma once
 
@@ -334,6 +335,13 @@ RefineResult refine(const FramesA& frames_a, const std::vector<double>& times_a,
   st.cross_links = links.size();
   st.cross_links_attempted = link_stats.attempted;
   st.cross_links_agreeing = link_stats.agreeing;
+  // Decided here, before the graph, the synchronisation and the sequence step: their work
+  // would rest on an extrinsic the views refuse (and a caller trying several is spared it).
+  if (!hots_detail::links_confirm(st, options))
+    return fail(RefineStatus::extrinsic_unconfirmed,
+                "too few of the cross links (b's submaps registered to a's through the "
+                "extrinsic) agree with it: the two LiDARs' views do not confirm the extrinsic "
+                "(statistics: cross_links_agreeing of cross_links_attempted)");
   using BoundaryLinks = std::vector<std::optional<CrossLink>>;
   const BoundaryLinks boundary_a =
       options.boundary_registration
@@ -487,11 +495,6 @@ RefineResult refine(const FramesA& frames_a, const std::vector<double>& times_a,
   const Isometry3d mapb_mapa = mapa_mapb.inverse();
   for (std::size_t i = 0; i < na; ++i) result.poses_a[i] = graph.variables[i];
   for (std::size_t j = 0; j < nb; ++j) result.poses_b[j] = mapb_mapa * graph.variables[na + j];
-  if (!hots_detail::links_confirm(st, options))
-    return fail(RefineStatus::extrinsic_unconfirmed,
-                "too few of the cross links (b's submaps registered to a's through the "
-                "extrinsic) agree with it: the two LiDARs' views do not confirm the extrinsic "
-                "(statistics: cross_links_agreeing of cross_links_attempted)");
   if (!st.sequence.time_offset_trusted)
     return fail(RefineStatus::time_offset_untrusted, st.sequence.time_offset_doubt);
   return result;

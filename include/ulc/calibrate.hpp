@@ -33,8 +33,16 @@
 //     whose clock offset the drive does not pin down fails too (time_offset_untrusted: the
 //     extrinsic would carry the offset's error times the speed); a caller who knows the
 //     clocks' offset sets time_offset_s, and then no offset is estimated or checked.
+//   - TERRA's hypotheses and HOTS as the judge (not in the paper): with HOTS on a moving rig,
+//     a JEEP that was rejected or did not settle hands its extrinsic to HOTS (hots_judges_jeep),
+//     and when the attempt from TERRA's best rotation fails in a way that points at the
+//     rotation (JEEP failed, or HOTS's extrinsic_unconfirmed), TERRA's next distinct optima run
+//     in turn (terra_hypotheses); the first success wins. With none, the best one's failure is
+//     reported. stages.terra.hypotheses lists each one tried and its outcome; timings sum
+//     over all of them.
 //   - Progress: options.progress(stage, fraction in [0, 1]) on the calling thread; stages
-//     "terra", "jeep", "odometry", "hots" (HOTS reports only 0 and 1).
+//     "terra", "jeep", "odometry", "hots" (HOTS reports only 0 and 1); a later hypothesis's
+//     stages carry " (hypothesis k)".
 //   - Threads: every stage is deterministic for any thread count, so is this. Run inside a
 //     tbb::task_arena to limit threads.
 //   - Nothing here throws, exits or prints; it compiles with -fno-exceptions.
@@ -56,6 +64,7 @@
 #include "ulc/calibrate/map_terra.hpp"
 #include "ulc/calibrate/pair_calibration.hpp"
 #include "ulc/calibrate/stages.hpp"
+#include "ulc/calibrate/terra_hypotheses.hpp"
 #include "ulc/core/point_traits.hpp"
 #include "ulc/core/types.hpp"
 
@@ -95,6 +104,22 @@ struct CalibrateOptions {
   /// ... and the frame search failed or its eq:mask count at its answer is below this many
   /// cells. The map result is then kept when it succeeded with a larger mask count.
   std::size_t terra_maps_below_mask = 100;
+  /// TERRA's hypotheses (ulc/calibrate/terra_hypotheses.hpp): when HOTS runs on a moving rig
+  /// and the stages after TERRA's best rotation fail in a way that points at the rotation
+  /// (JEEP fails, or HOTS finds the LiDARs' views disagree with it: extrinsic_unconfirmed),
+  /// the search's next distinct optima are tried in turn, up to this many in all; the first
+  /// success wins. 1 = the paper's single answer. Not in the paper.
+  std::size_t terra_hypotheses = 4;
+  /// Optima closer than this to a better one are the same hypothesis (JEEP converges from a few
+  /// degrees).
+  double terra_hypothesis_separation_deg = 10.0;
+  /// When HOTS runs on a moving rig, its cross links judge JEEP's extrinsic, not JEEP's own
+  /// acceptance: a JEEP that settled but was rejected, or did not settle, hands its extrinsic
+  /// to HOTS, and only HOTS's refusal (extrinsic_unconfirmed) ends the attempt. On narrow-FoV
+  /// targets JEEP's acceptance refuses right extrinsics (the seven-LiDAR rig's Tele, docs/
+  /// BENCHMARKS.md "TERRA's hypotheses"), while the cross links separate right from wrong.
+  /// false: any JEEP failure ends the attempt. Not in the paper.
+  bool hots_judges_jeep = true;
   jeep::JeepOptions jeep;          ///< K = 5 frame pairs, at most 10 rounds
   jeep::OdometryOptions odometry;  ///< the odometry over all frames that feeds HOTS
   hots::RefineOptions hots;        ///< windows of 5, 3 layers, time synchronisation on
@@ -113,6 +138,55 @@ struct CalibrateOptions {
 };
 
 namespace calibrate_detail {
+
+constexpr double kRadPerDeg = 3.14159265358979323846 / 180.0;
+
+/// How the stages after TERRA ended from one start, and whether the failure points at that
+/// start (JEEP failed, or HOTS's cross links refused the extrinsic): the next TERRA hypothesis
+/// is then worth a try.
+struct StageOutcome {
+  CalibrateStatus status = CalibrateStatus::ok;
+  std::string reason;
+  bool points_at_start = false;
+};
+
+inline TerraHypothesis hypothesis_entry(const terra::RotationCandidate& c) {
+  TerraHypothesis h;
+  h.rotation = c.rotation;
+  h.distance = c.distance;
+  h.mask_count = c.mask_count;
+  return h;
+}
+
+inline void add_timings(StageTimings& into, const StageTimings& t) {
+  into.jeep += t.jeep;
+  into.odometry += t.odometry;
+  into.hots += t.hots;
+}
+
+/// The stages' reports and outputs of one attempt into the result (timings are summed apart).
+inline void take_stages(PairCalibration& r, const PairCalibration& attempt) {
+  r.jeep = attempt.jeep;
+  r.hots = attempt.hots;
+  r.T_base_target = attempt.T_base_target;
+  r.time_offset_s = attempt.time_offset_s;
+  r.covariance_6x6 = attempt.covariance_6x6;
+}
+
+/// One sentence for a failed HOTS, with what to do about it.
+inline std::string hots_failure(const hots::RefineResult& h) {
+  std::string why = std::string("HOTS: ") + hots::to_string(h.status) + ": " + h.reason;
+  if (h.status == hots::RefineStatus::extrinsic_unconfirmed)
+    why += "; " + std::to_string(h.statistics.cross_links_agreeing) + " of " +
+           std::to_string(h.statistics.cross_links_attempted) +
+           " agree: the extrinsic before HOTS is likely wrong (TERRA's rotation or the initial "
+           "guess)";
+  if (h.status == hots::RefineStatus::time_offset_untrusted)
+    why +=
+        "; a longer drive with turns and speed changes pins it down, and synchronised clocks "
+        "are said so with time_offset_s = 0 (ulc calibrate --synced-clocks)";
+  return why;
+}
 
 inline double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -277,6 +351,13 @@ inline void add_refine(HotsReport& h, const hots::RefineResult& r, double second
   h.seconds = seconds;
 }
 
+/// A JEEP that ran to its end without a usable extrinsic's verdict (rejected, or not settled)
+/// with a finite extrinsic: HOTS can judge it (CalibrateOptions::hots_judges_jeep).
+inline bool hots_can_judge(const jeep::JeepResult& j) {
+  return (j.status == jeep::JeepStatus::rejected || j.status == jeep::JeepStatus::not_converged) &&
+         j.extrinsic.matrix().allFinite();
+}
+
 /// Odometry gave a pose to every frame (possibly predicted ones): HOTS can start.
 inline bool odometry_usable(const jeep::OdometryResult& odo) {
   return odo.ok() || odo.status == jeep::OdometryStatus::registration_failed;
@@ -290,6 +371,7 @@ PairCalibration calibrate_pair(const FramesA& frames_a, const std::vector<double
                                const FramesB& frames_b, const std::vector<double>& times_b_own,
                                const CalibrateOptions& options = {}) {
   using calibrate_detail::seconds_since;
+  using calibrate_detail::StageOutcome;
   const auto start = std::chrono::steady_clock::now();
   PairCalibration r;
   r.stages = options.stages;
@@ -300,7 +382,7 @@ PairCalibration calibrate_pair(const FramesA& frames_a, const std::vector<double
     r.timing_s.total = seconds_since(start);
     return r;
   };
-  auto report = [&](const char* stage, double fraction) {
+  auto report = [&](const std::string& stage, double fraction) {
     if (options.progress) options.progress(stage, fraction);
   };
 
@@ -342,9 +424,9 @@ PairCalibration calibrate_pair(const FramesA& frames_a, const std::vector<double
   if (!run_terra && !options.initial->matrix().allFinite())
     return finish(CalibrateStatus::invalid_input, "the initial extrinsic is not finite");
 
-  Isometry3d C = run_terra ? Isometry3d::Identity() : *options.initial;
-  r.T_base_target = C;
-
+  const Isometry3d start_guess = run_terra ? Isometry3d::Identity() : *options.initial;
+  r.T_base_target = start_guess;
+  std::vector<terra::RotationCandidate> hypotheses;
   if (run_terra) {
     const auto t0 = std::chrono::steady_clock::now();
     const terra::SearchResult s =
@@ -356,89 +438,148 @@ PairCalibration calibrate_pair(const FramesA& frames_a, const std::vector<double
       return finish(CalibrateStatus::terra_failed, std::string("TERRA: ") +
                                                        terra::to_string(s.status) + ": " +
                                                        s.reason + " (on " + r.terra->source + ")");
-    C = Isometry3d::Identity();
-    C.linear() = s.rotation;
-    r.T_base_target = C;
+    hypotheses =
+        terra_hypotheses(s, std::max<std::size_t>(1, options.terra_hypotheses),
+                         options.terra_hypothesis_separation_deg * calibrate_detail::kRadPerDeg);
+  }
+  if (!run_jeep && !run_hots) {
+    r.T_base_target.linear() = hypotheses.front().rotation;
+    r.terra->hypotheses.push_back(calibrate_detail::hypothesis_entry(hypotheses.front()));
+    r.terra->hypotheses.back().outcome = "ok";
+    return finish(CalibrateStatus::ok, "");
   }
 
-  if (run_jeep) {
-    const auto t0 = std::chrono::steady_clock::now();
-    const FrameRange<FramesA> view_a(frames_a, i);
-    const FrameRange<FramesB> view_b(frames_b, i);
-    jeep::ProgressFn progress;
-    if (options.progress)
-      progress = [&](std::size_t done, std::size_t total) {
-        report("jeep", total ? static_cast<double>(done) / static_cast<double>(total) : 1.0);
-      };
-    report("jeep", 0.0);
-    const jeep::JeepResult j = jeep::run_jeep(view_a, times_from(times_a, i), view_b,
-                                              times_from(times_b, i), C, options.jeep, progress);
-    r.jeep = calibrate_detail::jeep_report(j, C, seconds_since(t0));
-    r.timing_s.jeep = r.jeep->seconds;
-    if (!j.ok())
-      return finish(CalibrateStatus::jeep_failed,
-                    std::string("JEEP: ") + jeep::to_string(j.status) + ": " + j.reason);
-    report("jeep", 1.0);
-    C = j.extrinsic;
-    r.T_base_target = C;
-  }
-
+  // JEEP and odometry + HOTS from `start` on the frames from i on, into `out`.
   const std::size_t frames_left = std::min(frames_a.size(), frames_b.size()) - i;
-  if (run_hots && frames_left < options.hots_min_frames && (run_terra || run_jeep)) {
-    r.hots = HotsReport{};
-    r.hots->status = "skipped";
-    r.hots->reason = "only " + std::to_string(frames_left) + " frame(s) per LiDAR from frame " +
-                     std::to_string(i) + " (HOTS needs " + std::to_string(options.hots_min_frames) +
-                     " of a moving rig); the extrinsic is the previous stage's";
-    r.hots->initial = r.hots->extrinsic = C;
-  } else if (run_hots) {
+  const std::vector<double> ta = times_from(times_a, i), tb = times_from(times_b, i);
+  // HOTS can judge a start: it runs, on a moving rig.
+  const bool can_verify = run_hots && frames_left >= options.hots_min_frames;
+  auto run_from = [&](const Isometry3d& start, const std::string& label,
+                      PairCalibration& out) -> StageOutcome {
+    auto stage = [&](const char* name) { return label.empty() ? name : name + label; };
+    std::string jeep_failure;  // set when JEEP failed and HOTS judges its extrinsic
+    Isometry3d C = start;
+    out.T_base_target = C;
     const FrameRange<FramesA> view_a(frames_a, i);
     const FrameRange<FramesB> view_b(frames_b, i);
-    const std::vector<double> ta = times_from(times_a, i), tb = times_from(times_b, i);
+    auto progress_of = [&](const std::string& name) {
+      jeep::ProgressFn progress;
+      if (options.progress)
+        progress = [&, name](std::size_t done, std::size_t total) {
+          report(name, total ? static_cast<double>(done) / static_cast<double>(total) : 1.0);
+        };
+      return progress;
+    };
+    if (run_jeep) {
+      const auto t0 = std::chrono::steady_clock::now();
+      report(stage("jeep"), 0.0);
+      const jeep::JeepResult j =
+          jeep::run_jeep(view_a, ta, view_b, tb, C, options.jeep, progress_of(stage("jeep")));
+      out.jeep = calibrate_detail::jeep_report(j, C, seconds_since(t0));
+      out.timing_s.jeep = out.jeep->seconds;
+      report(stage("jeep"), 1.0);
+      if (!j.ok()) {
+        jeep_failure = std::string("JEEP: ") + jeep::to_string(j.status) + ": " + j.reason;
+        out.jeep->judged_by_hots =
+            options.hots_judges_jeep && can_verify && calibrate_detail::hots_can_judge(j);
+        if (!out.jeep->judged_by_hots) return {CalibrateStatus::jeep_failed, jeep_failure, true};
+      }
+      C = j.extrinsic;
+      if (j.ok()) out.T_base_target = C;
+    }
+    // A failed JEEP judged by HOTS: HOTS's refusal is JEEP's failure; its success overrules it.
+    auto failed = [&](CalibrateStatus status, std::string why, bool points_at_start) {
+      if (jeep_failure.empty()) return StageOutcome{status, std::move(why), points_at_start};
+      return StageOutcome{CalibrateStatus::jeep_failed,
+                          jeep_failure + " (HOTS, run from its extrinsic to judge it: " + why + ")",
+                          points_at_start};
+    };
+    if (!run_hots) return {CalibrateStatus::ok, "", false};
+    if (frames_left < options.hots_min_frames && (run_terra || run_jeep)) {
+      out.hots = HotsReport{};
+      out.hots->status = "skipped";
+      out.hots->reason = "only " + std::to_string(frames_left) + " frame(s) per LiDAR from frame " +
+                         std::to_string(i) + " (HOTS needs " +
+                         std::to_string(options.hots_min_frames) +
+                         " of a moving rig); the extrinsic is the previous stage's";
+      out.hots->initial = out.hots->extrinsic = C;
+      return {CalibrateStatus::ok, "", false};
+    }
     auto t0 = std::chrono::steady_clock::now();
-    jeep::ProgressFn progress;
-    if (options.progress)
-      progress = [&](std::size_t done, std::size_t total) {
-        report("odometry", total ? static_cast<double>(done) / static_cast<double>(total) : 1.0);
-      };
-    report("odometry", 0.0);
-    const jeep::OdometryResult odo =
-        jeep::run_odometry(view_a, ta, view_b, tb, C, options.odometry, progress);
-    r.timing_s.odometry = seconds_since(t0);
-    r.hots = calibrate_detail::hots_report(odo, C, r.timing_s.odometry);
+    report(stage("odometry"), 0.0);
+    const jeep::OdometryResult odo = jeep::run_odometry(view_a, ta, view_b, tb, C, options.odometry,
+                                                        progress_of(stage("odometry")));
+    out.timing_s.odometry = seconds_since(t0);
+    out.hots = calibrate_detail::hots_report(odo, C, out.timing_s.odometry);
     if (!calibrate_detail::odometry_usable(odo))
-      return finish(
+      return failed(
           CalibrateStatus::hots_failed,
-          std::string("HOTS: odometry: ") + jeep::to_string(odo.status) + ": " + odo.reason);
-    report("odometry", 1.0);
-    report("hots", 0.0);
+          std::string("HOTS: odometry: ") + jeep::to_string(odo.status) + ": " + odo.reason,
+          !jeep_failure.empty());
+    report(stage("odometry"), 1.0);
+    report(stage("hots"), 0.0);
     t0 = std::chrono::steady_clock::now();
     const hots::RefineResult h =
         hots::refine(view_a, ta, odo.poses_a, view_b, tb, odo.poses_b, C, hots_options);
-    r.timing_s.hots = seconds_since(t0);
-    calibrate_detail::add_refine(*r.hots, h, r.timing_s.hots);
-    r.hots->time_offset_s += r.time_offset_s;  // back to b's own clock
+    out.timing_s.hots = seconds_since(t0);
+    calibrate_detail::add_refine(*out.hots, h, out.timing_s.hots);
+    out.hots->time_offset_s += out.time_offset_s;  // back to b's own clock
     if (!h.ok())
-      return finish(CalibrateStatus::hots_failed,
-                    std::string("HOTS: ") + hots::to_string(h.status) + ": " + h.reason +
-                        (h.status == hots::RefineStatus::extrinsic_unconfirmed
-                             ? "; " + std::to_string(h.statistics.cross_links_agreeing) + " of " +
-                                   std::to_string(h.statistics.cross_links_attempted) +
-                                   " agree: the extrinsic before HOTS is likely wrong (TERRA's "
-                                   "rotation or the initial guess)"
-                             : std::string()) +
-                        (h.status == hots::RefineStatus::time_offset_untrusted
-                             ? "; a longer drive with turns and speed changes pins it down, "
-                               "and synchronised clocks are said so with time_offset_s = 0 "
-                               "(ulc calibrate --synced-clocks)"
-                             : ""));
-    report("hots", 1.0);
-    C = h.extrinsic;
-    r.T_base_target = C;
-    r.time_offset_s += h.time_offset_s;
-    r.covariance_6x6 = h.covariance_6x6;
+      return failed(CalibrateStatus::hots_failed, calibrate_detail::hots_failure(h),
+                    h.status == hots::RefineStatus::extrinsic_unconfirmed || !jeep_failure.empty());
+    report(stage("hots"), 1.0);
+    out.T_base_target = h.extrinsic;
+    out.time_offset_s += h.time_offset_s;
+    out.covariance_6x6 = h.covariance_6x6;
+    return {CalibrateStatus::ok, "", false};
+  };
+
+  if (!run_terra) {
+    const StageOutcome o = run_from(start_guess, "", r);
+    return finish(o.status, o.reason);
   }
-  return finish(CalibrateStatus::ok, "");
+
+  // TERRA's hypotheses in turn (terra_hypotheses.hpp): when what followed the best one points
+  // at the rotation (JEEP failed, or HOTS's cross links disagree) and HOTS can judge the next
+  // one, the next one runs. The first success wins.
+  PairCalibration first;
+  StageOutcome first_outcome;
+  for (std::size_t k = 0; k < hypotheses.size(); ++k) {
+    const auto t0 = std::chrono::steady_clock::now();
+    Isometry3d start = Isometry3d::Identity();
+    start.linear() = hypotheses[k].rotation;
+    TerraHypothesis entry = calibrate_detail::hypothesis_entry(hypotheses[k]);
+    const std::string label = k == 0 ? "" : " (hypothesis " + std::to_string(k + 1) + ")";
+    PairCalibration attempt;
+    attempt.time_offset_s = r.time_offset_s;
+    const StageOutcome o = run_from(start, label, attempt);
+    entry.outcome = o.status == CalibrateStatus::ok
+                        ? std::string("ok")
+                        : std::string(to_string(o.status)) + ": " + o.reason;
+    entry.seconds = seconds_since(t0);
+    r.terra->hypotheses.push_back(entry);
+    calibrate_detail::add_timings(r.timing_s, attempt.timing_s);
+    // A failure that does not point at the rotation (the views confirmed it, the clocks'
+    // offset is untrusted, say) is this hypothesis's own answer; so is the best's when no other
+    // can be judged.
+    const bool next_worth_it = can_verify && o.points_at_start && k + 1 < hypotheses.size();
+    if (o.status == CalibrateStatus::ok || (!next_worth_it && (k == 0 || !o.points_at_start))) {
+      calibrate_detail::take_stages(r, attempt);
+      r.terra->hypothesis_used = k;
+      return finish(o.status, o.reason);
+    }
+    if (k == 0) {
+      first = std::move(attempt);
+      first_outcome = o;
+    }
+  }
+  // None succeeded: the best hypothesis's outcome, and what the others said.
+  calibrate_detail::take_stages(r, first);
+  r.terra->hypothesis_used = 0;
+  return finish(first_outcome.status,
+                first_outcome.reason + "; TERRA's next " +
+                    std::to_string(r.terra->hypotheses.size() - 1) +
+                    " hypotheses were not confirmed either (stages.terra.hypotheses)");
 }
 
 }  // namespace ulc

@@ -128,6 +128,9 @@ TEST_CASE("an extrinsic the LiDARs' views do not confirm is refused", "[hots][re
   CHECK(st.cross_links_attempted >= options.min_cross_links);
   CHECK(st.cross_links_agreeing < options.min_cross_links);
   CHECK(st.cross_links_agreeing <= st.cross_links);
+  // Decided before the graph: the extrinsic comes back as it went in.
+  CHECK(r.extrinsic.matrix() == wrong.matrix());
+  CHECK(st.graph_iterations == 0);
   // The rule is the statistics' own verdict: off, the same run reaches the next check.
   options.min_cross_link_ratio = 0.0;
   const hots::RefineResult unchecked =

@@ -56,6 +56,16 @@ inline const char* to_string(CalibrateStatus s) {
   }
 }
 
+/// One of TERRA's hypotheses the pipeline started from (terra_hypotheses.hpp) and what became of
+/// it.
+struct TerraHypothesis {
+  Mat3d rotation = Mat3d::Identity();  ///< R_base_target
+  double distance = 0.0;               ///< eq:feature_dis
+  std::size_t mask_count = 0;          ///< eq:mask cells
+  std::string outcome;                 ///< "ok", or the calibration status and reason it ended with
+  double seconds = 0.0;                ///< JEEP, odometry and HOTS from this hypothesis
+};
+
 /// The TERRA stage: a rotation from one frame of each LiDAR, or from each LiDAR's local map
 /// over a short window from that frame (map_terra.hpp), no prior. The fields above `source`
 /// describe the search whose rotation was kept.
@@ -77,6 +87,11 @@ struct TerraReport {
   std::optional<std::size_t> frames_mask_count;
   std::string frames_status;
   std::optional<LocalMapStats> base_map, target_map;  ///< when the map search ran
+  /// The hypotheses the later stages started from, in the order tried (the first is the
+  /// search's best, `rotation`), and the index of the one the result comes from (the first
+  /// when none succeeded).
+  std::vector<TerraHypothesis> hypotheses;
+  std::size_t hypothesis_used = 0;
 };
 
 /// The JEEP stage: extrinsic and poses over the first K frame pairs.
@@ -97,6 +112,9 @@ struct JeepReport {
   bool two_way = false;
   double two_way_gap_translation = 0.0;  ///< m
   double two_way_gap_rotation = 0.0;     ///< rad
+  /// JEEP failed (rejected or not settled) and HOTS ran from its extrinsic to judge it
+  /// (CalibrateOptions::hots_judges_jeep): the pair's status says which won.
+  bool judged_by_hots = false;
   double seconds = 0.0;
 };
 

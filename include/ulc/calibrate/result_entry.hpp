@@ -83,6 +83,18 @@ inline io::Json terra_to_json(const TerraReport& t) {
   }
   if (t.base_map) j["base_map"] = result_detail::local_map_stats(*t.base_map);
   if (t.target_map) j["target_map"] = result_detail::local_map_stats(*t.target_map);
+  io::Json hypotheses = io::Json::array();
+  for (const TerraHypothesis& h : t.hypotheses) {
+    io::Json e = io::Json::object();
+    e["rpy_deg"] = io::vector_to_json(rpy_from_rotation(h.rotation) * result_detail::kDegPerRad);
+    e["distance"] = h.distance;
+    e["mask_count"] = h.mask_count;
+    e["outcome"] = h.outcome;
+    e["seconds"] = h.seconds;
+    hypotheses.push_back(std::move(e));
+  }
+  j["hypotheses"] = std::move(hypotheses);
+  j["hypothesis_used"] = t.hypothesis_used;
   return j;
 }
 
@@ -103,6 +115,7 @@ inline io::Json jeep_to_json(const JeepReport& r) {
   j["two_way"] = r.two_way;
   j["two_way_gap_m"] = r.two_way_gap_translation;
   j["two_way_gap_deg"] = r.two_way_gap_rotation * result_detail::kDegPerRad;
+  j["judged_by_hots"] = r.judged_by_hots;
   j["seconds"] = r.seconds;
   return j;
 }

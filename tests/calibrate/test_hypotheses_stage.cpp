@@ -1,0 +1,108 @@
+// HOTS as the pipeline's judge (ulc/calibrate.hpp): TERRA's next hypotheses run when the stages
+// after its best rotation fail in a way that points at the rotation, and a JEEP that did not
+// settle hands its extrinsic to HOTS instead of ending the call.
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "calibrate_test_util.hpp"
+#include "ulc/calibrate.hpp"
+#include "ulc/calibrate/result_entry.hpp"
+#include "ulc/core/pose_error.hpp"
+
+using namespace calibrate_test;
+using ulc::CalibrateStatus;
+using ulc::Stage;
+
+TEST_CASE("when HOTS refuses every start, TERRA's next hypotheses are tried and reported",
+          "[calibrate][hypotheses]") {
+  const auto& d = drive_64_32_hots();
+  const auto& a = d.lidars[0];
+  const auto& b = d.lidars[1];
+  ulc::CalibrateOptions o;
+  o.time_offset_s = 0.0;
+  // A judge nothing can satisfy: every start ends extrinsic_unconfirmed.
+  o.hots.min_cross_links = std::numeric_limits<std::size_t>::max();
+  std::vector<std::string> stages_seen;
+  o.progress = [&](const std::string& stage, double) {
+    if (stages_seen.empty() || stages_seen.back() != stage) stages_seen.push_back(stage);
+  };
+  const auto c = ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, o);
+  INFO(ulc::to_string(c.status) << ": " << c.reason);
+  CHECK_FALSE(c.success);
+  REQUIRE(c.terra);
+  const auto& tried = c.terra->hypotheses;
+  REQUIRE(tried.size() >= 2);
+  CHECK(tried.size() <= o.terra_hypotheses);
+  // Best first (TERRA's own answer), distances in order, distinct basins.
+  CHECK(tried[0].rotation.isApprox(c.terra->rotation));
+  for (std::size_t k = 0; k < tried.size(); ++k) {
+    INFO("hypothesis " << k << ": " << tried[k].outcome);
+    CHECK((tried[k].outcome.find("extrinsic_unconfirmed") != std::string::npos ||
+           tried[k].outcome.find("jeep_failed") != std::string::npos));
+    if (k > 0) CHECK(tried[k - 1].distance <= tried[k].distance);
+    for (std::size_t m = 0; m < k; ++m)
+      CHECK(ulc::rotation_error_rad(tried[m].rotation, tried[k].rotation) >=
+            o.terra_hypothesis_separation_deg * kDeg);
+  }
+  // The result is the best hypothesis's failure, its JEEP started from TERRA's best.
+  CHECK(c.terra->hypothesis_used == 0);
+  CHECK_THAT(c.reason, Catch::Contains("hypotheses were not confirmed either"));
+  REQUIRE(c.jeep);
+  CHECK(c.jeep->initial.linear().isApprox(tried[0].rotation));
+  CHECK(std::find(stages_seen.begin(), stages_seen.end(), "jeep (hypothesis 2)") !=
+        stages_seen.end());
+  const auto entry = ulc::to_pair_result(c, "lidar64", "lidar32");
+  CHECK(entry.stages.at("terra").at("hypotheses").size() == tried.size());
+  CHECK(entry.stages.at("terra").at("hypothesis_used").as_number() == 0.0);
+
+  // One hypothesis: the paper's single answer, and nothing else is tried.
+  o.terra_hypotheses = 1;
+  const auto single = ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, o);
+  REQUIRE(single.terra);
+  CHECK(single.terra->hypotheses.size() == 1);
+  CHECK(single.status == c.status);
+  CHECK_THAT(single.reason, !Catch::Contains("hypotheses"));
+}
+
+TEST_CASE("a JEEP that did not settle is judged by HOTS, which confirms and refines it",
+          "[calibrate][hypotheses]") {
+  const auto& d = drive_64_32_hots();
+  const auto& a = d.lidars[0];
+  const auto& b = d.lidars[1];
+  const ulc::Isometry3d truth = d.pairs[0].T_base_target;
+  ulc::CalibrateOptions o;
+  o.stages = {Stage::jeep, Stage::hots};
+  o.initial = disturbed(truth, 3, 2.0 * kDeg, 0.3);
+  o.time_offset_s = 0.0;
+  o.jeep.max_rounds = 1;  // JEEP cannot settle in one round
+  const auto c = ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, o);
+  INFO(ulc::to_string(c.status) << ": " << c.reason);
+  REQUIRE(c.jeep);
+  CHECK(c.jeep->status == "not_converged");
+  CHECK(c.jeep->judged_by_hots);
+  REQUIRE(c.success);
+  REQUIRE(c.hots);
+  CHECK(same_bits(c.hots->initial, c.jeep->extrinsic));
+  const auto e = ulc::pose_error(truth, c.T_base_target);
+  const auto ej = ulc::pose_error(truth, c.jeep->extrinsic);
+  INFO("HOTS " << e.rotation_deg << " deg " << e.translation_m << " m; JEEP " << ej.rotation_deg
+               << " deg " << ej.translation_m << " m");
+  CHECK(e.rotation_deg < 0.1);
+  CHECK(e.translation_m < 0.02);
+  CHECK(ulc::to_pair_result(c, "lidar64", "lidar32")
+            .stages.at("jeep")
+            .at("judged_by_hots")
+            .as_bool());
+
+  // JEEP's verdict stands when asked to: the call ends with JEEP's failure and its input.
+  o.hots_judges_jeep = false;
+  const auto vetoed = ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, o);
+  CHECK(vetoed.status == CalibrateStatus::jeep_failed);
+  REQUIRE(vetoed.jeep);
+  CHECK_FALSE(vetoed.jeep->judged_by_hots);
+  CHECK(!vetoed.hots);
+  CHECK(same_bits(vetoed.T_base_target, *o.initial));
+}

@@ -1,0 +1,75 @@
+// TERRA's hypotheses (ulc/calibrate/terra_hypotheses.hpp): the search's optima, best first,
+// one per basin, and the first always the search's own answer.
+#include <catch2/catch.hpp>
+
+#include <Eigen/Geometry>
+#include <cmath>
+
+#include "ulc/calibrate/terra_hypotheses.hpp"
+
+namespace {
+
+constexpr double kDeg = 3.14159265358979323846 / 180.0;
+
+ulc::Mat3d yaw(double deg) {
+  return Eigen::AngleAxisd(deg * kDeg, ulc::Vec3d::UnitZ()).toRotationMatrix();
+}
+
+terra::RotationCandidate candidate(double yaw_deg, double distance) {
+  terra::RotationCandidate c;
+  c.rotation = yaw(yaw_deg);
+  c.distance = distance;
+  c.mask_count = 100;
+  return c;
+}
+
+/// A successful search whose refined optima are `refined` (in seed order).
+terra::SearchResult search_with(std::vector<terra::RotationCandidate> refined) {
+  terra::SearchResult s;
+  s.status = terra::SearchStatus::ok;
+  s.refined = std::move(refined);
+  std::size_t best = 0;
+  for (std::size_t k = 1; k < s.refined.size(); ++k)
+    if (s.refined[k].distance < s.refined[best].distance) best = k;
+  s.rotation = s.refined[best].rotation;
+  s.distance = s.refined[best].distance;
+  return s;
+}
+
+std::vector<double> yaws_of(const std::vector<terra::RotationCandidate>& h) {
+  std::vector<double> out;
+  for (const auto& c : h) out.push_back(std::atan2(c.rotation(1, 0), c.rotation(0, 0)) / kDeg);
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("TERRA's hypotheses are its optima, best first, one per basin",
+          "[calibrate][terra_hypotheses]") {
+  // Seed order differs from distance order; 2 and 8 deg are one basin (10 deg apart at most),
+  // 166 deg is the street's twin.
+  const terra::SearchResult s =
+      search_with({candidate(166.0, 0.004), candidate(8.0, 0.003), candidate(2.0, 0.005),
+                   candidate(-60.0, 0.006), candidate(100.0, 0.006)});
+  const auto h = ulc::terra_hypotheses(s, 10, 10.0 * kDeg);
+  const std::vector<double> yaws = yaws_of(h);
+  REQUIRE(yaws.size() == 4);
+  CHECK(yaws[0] == Approx(8.0));  // the search's answer
+  CHECK(h[0].rotation.isApprox(s.rotation));
+  CHECK(yaws[1] == Approx(166.0));
+  CHECK(yaws[2] == Approx(-60.0));  // equal distances: seed order
+  CHECK(yaws[3] == Approx(100.0));
+  for (std::size_t k = 1; k < h.size(); ++k) CHECK(h[k - 1].distance <= h[k].distance);
+
+  // At most max_count; a smaller separation keeps the 2-deg optimum as its own hypothesis.
+  CHECK(ulc::terra_hypotheses(s, 2, 10.0 * kDeg).size() == 2);
+  const auto fine = yaws_of(ulc::terra_hypotheses(s, 10, 5.0 * kDeg));
+  REQUIRE(fine.size() == 5);
+  CHECK(fine[2] == Approx(2.0));
+}
+
+TEST_CASE("a failed search has no hypothesis", "[calibrate][terra_hypotheses]") {
+  terra::SearchResult s = search_with({candidate(10.0, 0.01)});
+  s.status = terra::SearchStatus::no_overlap;
+  CHECK(ulc::terra_hypotheses(s, 4, 10.0 * kDeg).empty());
+}
