@@ -283,8 +283,7 @@ Run one_run(const std::string& scenario, double offset_s, std::size_t run, const
     // As the pipeline does (CalibrateOptions::hots_judges_jeep): a JEEP that was rejected or
     // did not settle hands its extrinsic to HOTS, whose cross links judge it.
     out.judged_by_hots = !j.success && c.hots_judges_jeep && j.jeep &&
-                         (j.jeep->status == "rejected" || j.jeep->status == "not_converged") &&
-                         C.matrix().allFinite();
+                         ulc::calibrate_detail::hots_can_judge(*j.jeep);
     if (!j.success && !out.judged_by_hots) return;
     auto t0 = std::chrono::steady_clock::now();
     const auto odo = jeep::run_odometry(a.frames, a.timestamps, b.frames, times_b, C, o.odometry);

@@ -1,4 +1,4 @@
-// bench_trust: does HOTS tell a right extrinsic from a wrong one that JEEP accepted?
+// bench_trust: does HOTS tell a right extrinsic from a wrong one JEEP accepted or handed over?
 //
 //   bench_trust [--scenarios 64-tele,horizon-tele,64-32] [--seconds 20] [--runs 2]
 //               [--first-run 0] [--threads 2] [--json]
@@ -8,9 +8,10 @@
 // such starts on purpose: per scenario and run (seed = run + 1), JEEP (K = 5, the pipeline's
 // options) starts from the true rotation, from the paper's disturbance (5 deg about a random
 // axis, 2 m), and from the true rotation turned by 10, 20, 45, 90 and 166 deg of yaw, each with
-// zero translation. Where JEEP accepts, the pipeline's odometry and HOTS run with the cross-link
-// trust rule switched off (RefineOptions::min_cross_link_ratio = 0) so that every start shows
-// what HOTS would have returned; the table gives the cross links agreeing with the start,
+// zero translation. Where JEEP accepts, or fails in a way the pipeline hands to HOTS (rejected,
+// not settled: CalibrateOptions::hots_judges_jeep), the pipeline's odometry and HOTS run with the
+// cross-link trust rule switched off (RefineOptions::min_cross_link_ratio = 0) so that every start
+// shows what HOTS would have returned; the table gives the cross links agreeing with the start,
 // kept, and attempted (cross_links.hpp), the verdict the default rule would give (confirmed /
 // unconfirmed), and the truth (right: HOTS's extrinsic within the paper's success threshold,
 // 1 deg and 10 cm). The figure of merit: the largest agreeing share among wrong results
@@ -105,7 +106,9 @@ void bench(const Config& c) {
                                 ulc::to_string(j.status),
                                 Cell::num(je.rotation_deg, 3),
                                 Cell::num(100.0 * je.translation_m, 2)};
-          if (!j.success) {
+          // As the pipeline does (CalibrateOptions::hots_judges_jeep): a JEEP that was rejected
+          // or did not settle hands its extrinsic to HOTS.
+          if (!j.success && !(j.jeep && ulc::calibrate_detail::hots_can_judge(*j.jeep))) {
             for (int k = 0; k < 7; ++k) row.push_back("-");
             table.add_row(row);
             return;

@@ -358,6 +358,14 @@ inline bool hots_can_judge(const jeep::JeepResult& j) {
          j.extrinsic.matrix().allFinite();
 }
 
+/// The same from a JEEP stage's report (for callers that ran JEEP through calibrate_pair and
+/// run HOTS themselves, as the benchmarks do).
+inline bool hots_can_judge(const JeepReport& j) {
+  return (j.status == jeep::to_string(jeep::JeepStatus::rejected) ||
+          j.status == jeep::to_string(jeep::JeepStatus::not_converged)) &&
+         j.extrinsic.matrix().allFinite();
+}
+
 /// Odometry gave a pose to every frame (possibly predicted ones): HOTS can start.
 inline bool odometry_usable(const jeep::OdometryResult& odo) {
   return odo.ok() || odo.status == jeep::OdometryStatus::registration_failed;
