@@ -110,6 +110,15 @@ void print_summary(const io::PairResult& r) {
   if (!r.via.empty())
     std::printf("  route   %s <- %s <- %s (direct: %s)\n", r.base.c_str(), r.via.c_str(),
                 r.target.c_str(), r.direct_status.c_str());
+  // TERRA's later hypotheses ran (calibrate.hpp): say which one the result comes from.
+  if (const io::Json* terra = r.stages.find("terra")) {
+    const io::Json* tried = terra->find("hypotheses");
+    if (tried && tried->size() > 1)
+      std::printf(
+          "  terra   %zu hypotheses tried, the result from hypothesis %.0f "
+          "(stages.terra.hypotheses)\n",
+          tried->size(), terra->at("hypothesis_used").as_number() + 1.0);
+  }
   const Eigen::Vector3d t = r.T_base_target.translation();
   const Eigen::Vector3d rpy = ulc::rpy_from_rotation(r.T_base_target.linear()) * kDeg;
   std::printf("  xyz_m   %9.4f %9.4f %9.4f\n", t.x(), t.y(), t.z());
