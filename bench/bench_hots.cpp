@@ -327,12 +327,7 @@ Run one_run(const std::string& scenario, double offset_s, std::size_t run, const
 void emit(const ulc_bench::Table& table, const std::string& name, const Config& c,
           const std::vector<std::pair<std::string, Cell>>& parameters,
           const std::vector<std::pair<std::string, Cell>>& notes) {
-  if (c.bench.json) {
-    table.write_json(std::cout, name, ulc_bench::machine(), 1, parameters, notes);
-  } else {
-    table.print(std::cout);
-    for (const auto& n : notes) std::cout << n.first << ": " << n.second.text << "\n";
-  }
+  ulc_bench::emit(std::cout, table, c.bench.json, name, 1, parameters, notes);
 }
 
 /// Run `r`'s spread curve to PREFIX_<scenario>_<offset_ms>ms.png (see the header comment).

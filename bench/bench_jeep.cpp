@@ -224,12 +224,7 @@ Outcome run_scan_scan(const Drive& d, std::size_t pair, const Isometry3d& initia
 void emit(const ulc_bench::Table& table, const std::string& name, const Config& c,
           const std::vector<std::pair<std::string, Cell>>& parameters,
           const std::vector<std::pair<std::string, Cell>>& notes = {}) {
-  if (c.bench.json) {
-    table.write_json(std::cout, name, ulc_bench::machine(), c.bench.repeats, parameters, notes);
-  } else {
-    table.print(std::cout);
-    for (const auto& n : notes) std::cout << n.first << ": " << n.second.text << "\n";
-  }
+  ulc_bench::emit(std::cout, table, c.bench.json, name, c.bench.repeats, parameters, notes);
 }
 
 std::string scenario_list(const Config& c) {

@@ -168,7 +168,7 @@ void bench(const Config& c) {
     targets.print(std::cout);
     std::cout << "\n";
     cycles.print(std::cout);
-    for (const auto& n : notes) std::cout << n.first << ": " << n.second.text << "\n";
+    ulc_bench::print_notes(std::cout, notes);
   }
 }
 

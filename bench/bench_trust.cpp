@@ -172,16 +172,11 @@ void bench(const Config& c) {
       {"right_min_agree_pct", pct(m.right_min, m.right > 0)},
       {"wrong_confirmed", Cell::integer(static_cast<long long>(m.wrong_confirmed))},
       {"right_unconfirmed", Cell::integer(static_cast<long long>(m.right_unconfirmed))}};
-  if (c.bench.json) {
-    table.write_json(std::cout, "trust", ulc_bench::machine(), 1,
-                     {{"seconds", Cell::num(c.seconds, 1)},
-                      {"runs", Cell::integer(static_cast<long long>(c.runs))},
-                      {"threads", Cell::integer(c.threads)}},
-                     notes);
-  } else {
-    table.print(std::cout);
-    for (const auto& n : notes) std::cout << n.first << ": " << n.second.text << "\n";
-  }
+  ulc_bench::emit(std::cout, table, c.bench.json, "trust", 1,
+                  {{"seconds", Cell::num(c.seconds, 1)},
+                   {"runs", Cell::integer(static_cast<long long>(c.runs))},
+                   {"threads", Cell::integer(c.threads)}},
+                  notes);
 }
 
 }  // namespace

@@ -202,6 +202,25 @@ class Table {
   std::vector<std::vector<Cell>> rows_;
 };
 
+/// (key, cell) pairs: a benchmark's parameters or the notes printed after its table.
+using Fields = std::vector<std::pair<std::string, Cell>>;
+
+/// The notes as "key: value" lines, after a printed table.
+inline void print_notes(std::ostream& out, const Fields& notes) {
+  for (const auto& n : notes) out << n.first << ": " << n.second.text << "\n";
+}
+
+/// A benchmark's output: the table as JSON (--json), else the table and its notes as text.
+inline void emit(std::ostream& out, const Table& table, bool json, const std::string& name,
+                 int repeats, const Fields& parameters, const Fields& notes) {
+  if (json) {
+    table.write_json(out, name, machine(), repeats, parameters, notes);
+  } else {
+    table.print(out);
+    print_notes(out, notes);
+  }
+}
+
 /// "a,b,,c" -> {"a", "b", "c"}: the comma-separated lists of the benchmarks' options.
 inline std::vector<std::string> split_list(const std::string& s) {
   std::vector<std::string> out;

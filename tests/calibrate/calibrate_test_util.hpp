@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstring>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "ulc/calibrate.hpp"
@@ -87,6 +88,13 @@ inline ulc::Isometry3d disturbed(const ulc::Isometry3d& truth, std::uint64_t see
   out.linear() = truth.linear() * ulc::so3_exp(ulc::Vec3d(angle_rad * axis));
   out.translation() = truth.translation() + distance_m * dir;
   return out;
+}
+
+/// A progress callback that records each stage name once, in the order the stages report.
+inline ulc::CalibrateProgress record_stages(std::vector<std::string>& seen) {
+  return [&seen](const std::string& stage, double) {
+    if (seen.empty() || seen.back() != stage) seen.push_back(stage);
+  };
 }
 
 inline bool same_bits(const ulc::Isometry3d& a, const ulc::Isometry3d& b) {

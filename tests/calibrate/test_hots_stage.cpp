@@ -51,9 +51,7 @@ TEST_CASE("terra,jeep,hots recovers the 64-32 mounting with synchronised clocks"
   ulc::CalibrateOptions o;  // the default stages: terra, jeep, hots
   REQUIRE(o.stages == std::vector<Stage>{Stage::terra, Stage::jeep, Stage::hots});
   o.time_offset_s = 0.0;  // the simulated clocks agree, and the user says so
-  o.progress = [&](const std::string& stage, double) {
-    if (stages_seen.empty() || stages_seen.back() != stage) stages_seen.push_back(stage);
-  };
+  o.progress = record_stages(stages_seen);
   const auto c = ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, o);
   INFO(ulc::to_string(c.status) << ": " << c.reason);
   REQUIRE(c.success);

@@ -26,9 +26,7 @@ TEST_CASE("when HOTS refuses every start, TERRA's next hypotheses are tried and 
   // A judge nothing can satisfy: every start ends extrinsic_unconfirmed.
   o.hots.min_cross_links = std::numeric_limits<std::size_t>::max();
   std::vector<std::string> stages_seen;
-  o.progress = [&](const std::string& stage, double) {
-    if (stages_seen.empty() || stages_seen.back() != stage) stages_seen.push_back(stage);
-  };
+  o.progress = record_stages(stages_seen);
   const auto c = ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, o);
   INFO(ulc::to_string(c.status) << ": " << c.reason);
   CHECK_FALSE(c.success);

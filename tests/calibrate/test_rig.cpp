@@ -64,9 +64,7 @@ TEST_CASE("a three-LiDAR ring: every target within 0.5 deg and 5 cm, the cycle c
   for (const auto& l : d.lidars) frames.push_back(as_double_clouds(l.frames));
   std::vector<std::string> stages_seen;
   ulc::RigOptions o = terra_jeep();
-  o.pair.progress = [&](const std::string& stage, double) {
-    if (stages_seen.empty() || stages_seen.back() != stage) stages_seen.push_back(stage);
-  };
+  o.pair.progress = record_stages(stages_seen);
   const ulc::RigCalibration rig = ulc::calibrate_rig(views(d, frames), 0, o);
   INFO(ulc::to_string(rig.status) << ": " << rig.reason);
   REQUIRE(rig.ok());
