@@ -13,7 +13,8 @@
 //     b through C, eq:je_odom) from scans deskewed with the previous round's twists, then the
 //     calibration phase (map_registration.hpp: map b, made from b's scans and poses, registered
 //     to map a from C, eq:calib_map) gives the next C. Each round starts its maps afresh; the
-//     previous round's poses are the pose phase's initial guesses.
+//     previous round's poses are the pose phase's initial guesses. The first round's
+//     calibration phase searches a few starts around C (start_search.hpp).
 //   - Settled: the round changed C by less than settle_translation / settle_rotation and every
 //     pose of a by less than the same. No settling within max_rounds (the paper: "exceeding a
 //     certain number of iterations is a failure"; 10) gives status not_converged.
@@ -34,6 +35,7 @@
 #include "jeep/odometry.hpp"
 #include "jeep/run_odometry.hpp"
 #include "jeep/scan_preparation.hpp"
+#include "jeep/start_search.hpp"
 #include "jeep/two_way.hpp"
 #include "ulc/core/lie.hpp"
 #include "ulc/core/point_traits.hpp"
@@ -46,6 +48,9 @@ struct JeepOptions {
   int max_rounds = 10;     ///< more rounds without settling is a failure
   OdometryOptions odometry = jeep_pose_phase_options();
   MapRegistrationOptions calibration = default_map_registration();
+  /// The first calibration phase also starts from turned and shifted copies of the initial
+  /// extrinsic and keeps the best basin (start_search.hpp).
+  StartSearchOptions start_search;
   /// Calibration stages (the last ones) used after the first round, when C moves little.
   std::size_t refine_stages = 2;
   /// Settled when a round moves C and every pose by less than this: a fourth of the 2 cm and
@@ -107,6 +112,7 @@ struct JeepResult {
   std::vector<Vec6d> twists;  ///< per pair: a's body twist over its sweep, per second
   int rounds = 0;
   RegistrationResult<double> calibration;  ///< the last calibration phase
+  StartSearchReport start_search;          ///< the first calibration phase's start search
   AcceptanceReport acceptance;
   TwoWayResult two_way;  ///< the last step when JeepOptions::two_way (applied: it was used)
   std::vector<JeepRound> trace;
@@ -233,7 +239,10 @@ JeepResult run_jeep(const FramesA& frames_a, const std::vector<double>& times_a,
     if (round > 1 && stages.stages.size() > options.refine_stages)
       stages.stages.erase(stages.stages.begin(),
                           stages.stages.end() - static_cast<std::ptrdiff_t>(options.refine_stages));
-    const auto calibration = register_maps(map_b, target, C, stages);
+    const auto calibration =
+        round == 1 ? register_maps_searching(map_b, target, C, stages, options.start_search,
+                                             &result.start_search)
+                   : register_maps(map_b, target, C, stages);
     trace.calibration_status = calibration.status;
 
     detail::pose_change(C, calibration.pose, trace.change_translation, trace.change_rotation);

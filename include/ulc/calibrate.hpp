@@ -321,6 +321,8 @@ inline JeepReport jeep_report(const jeep::JeepResult& j, const Isometry3d& initi
   r.two_way = j.two_way.applied;
   r.two_way_gap_translation = j.two_way.gap_translation;
   r.two_way_gap_rotation = j.two_way.gap_rotation;
+  r.start_basins = j.start_search.basins;
+  r.start_chosen = j.start_search.chosen;
   r.seconds = seconds;
   return r;
 }

@@ -131,6 +131,9 @@ TEST_CASE("ulc calibrate terra,jeep passes ulc evaluate", "[app][calibrate]") {
   REQUIRE(r.size() == 1);
   CHECK(r[0].stages.at("jeep").at("status").as_string() == "ok");
   CHECK(r[0].stages.at("jeep").at("frame_pairs").as_number() == 5);
+  // The start search ran (jeep/start_search.hpp): at least the guess's own basin, a start index.
+  CHECK(r[0].stages.at("jeep").at("start_basins").as_number() >= 1);
+  CHECK(r[0].stages.at("jeep").at("start_chosen").as_number() < 13);
   CHECK(evaluate_success(d, out));
 }
 

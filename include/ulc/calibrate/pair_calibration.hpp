@@ -112,6 +112,10 @@ struct JeepReport {
   bool two_way = false;
   double two_way_gap_translation = 0.0;  ///< m
   double two_way_gap_rotation = 0.0;     ///< rad
+  /// The first calibration phase's start search (jeep/start_search.hpp): distinct basins
+  /// scored, and the start whose basin won (0: the initial extrinsic's own).
+  std::size_t start_basins = 0;
+  std::size_t start_chosen = 0;
   /// JEEP failed (rejected or not settled) and HOTS ran from its extrinsic to judge it
   /// (CalibrateOptions::hots_judges_jeep): the pair's status says which won.
   bool judged_by_hots = false;

@@ -115,6 +115,8 @@ inline io::Json jeep_to_json(const JeepReport& r) {
   j["two_way"] = r.two_way;
   j["two_way_gap_m"] = r.two_way_gap_translation;
   j["two_way_gap_deg"] = r.two_way_gap_rotation * result_detail::kDegPerRad;
+  j["start_basins"] = r.start_basins;
+  j["start_chosen"] = r.start_chosen;
   j["judged_by_hots"] = r.judged_by_hots;
   j["seconds"] = r.seconds;
   return j;
