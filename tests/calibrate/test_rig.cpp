@@ -56,9 +56,13 @@ ulc::RigOptions terra_jeep() {
 
 }  // namespace
 
-TEST_CASE("a three-LiDAR ring: every target within 0.5 deg and 5 cm, the cycle closes",
+TEST_CASE("a three-LiDAR rig: every target within 0.5 deg and 5 cm, the cycle closes",
           "[calibrate][rig]") {
-  const ulc::sim::Dataset d = short_rig("ring-5x16", {"roof", "front_left", "front_right"});
+  // Three spinning LiDARs of the seven-LiDAR rig. (Until session 12 this was three VLP-16s of
+  // the ring, 90 deg apart; JEEP's acceptance now refuses their corner-to-corner pairs on 0.6 s
+  // of data: the directional overlap is 0.16-0.22 there, below its 0.25, acceptance.hpp. The
+  // ring itself is bench_rig's, with HOTS, which calibrates every target.)
+  const ulc::sim::Dataset d = short_rig("colorful", {"lidar64", "lidar32", "lidar16"});
   // Double clouds with point times (the float path is the routing test's).
   std::vector<std::vector<ulc::PointCloud<double>>> frames;
   for (const auto& l : d.lidars) frames.push_back(as_double_clouds(l.frames));
@@ -67,24 +71,27 @@ TEST_CASE("a three-LiDAR ring: every target within 0.5 deg and 5 cm, the cycle c
   o.pair.progress = record_stages(stages_seen);
   const ulc::RigCalibration rig = ulc::calibrate_rig(views(d, frames), 0, o);
   INFO(ulc::to_string(rig.status) << ": " << rig.reason);
+  for (const ulc::RigTarget& t : rig.targets)
+    UNSCOPED_INFO(t.name << ": " << t.direct.reason << ", directional overlap "
+                         << (t.direct.jeep ? t.direct.jeep->directional_overlap : 0.0));
   REQUIRE(rig.ok());
-  CHECK(rig.base_name == "roof");
+  CHECK(rig.base_name == "lidar64");
   REQUIRE(rig.targets.size() == 2);
   for (const ulc::RigTarget& t : rig.targets) {
     const ulc::PoseError e = ulc::pose_error(truth(d, 0, t.lidar), t.result.T_base_target);
     INFO(t.name << ": " << t.result.reason << " e_rot " << e.rotation_deg << " deg, e_trans "
                 << e.translation_m << " m");
     CHECK(t.ok());
-    CHECK_FALSE(t.routed());  // every corner sees the roof's surroundings
+    CHECK_FALSE(t.routed());  // every LiDAR sees the base's surroundings
     CHECK(t.failed_routes.empty());
     CHECK(same_bits(t.result.T_base_target, t.direct.T_base_target));
     CHECK(e.rotation_deg < 0.5);
     CHECK(e.translation_m < 0.05);
   }
-  CHECK(rig.targets[0].name == "front_left");
+  CHECK(rig.targets[0].name == "lidar32");
   CHECK(rig.targets[1].lidar == 2);
 
-  // The one cycle roof -> front_left -> front_right -> roof: its own calibration is near the
+  // The one cycle lidar64 -> lidar32 -> lidar16 -> lidar64: its own calibration is near the
   // truth, and the chained extrinsics close to within the targets' own accuracy.
   REQUIRE(rig.cycles.size() == 1);
   const ulc::RigCycle& c = rig.cycles[0];
@@ -107,10 +114,9 @@ TEST_CASE("a three-LiDAR ring: every target within 0.5 deg and 5 cm, the cycle c
   CHECK(c.pair.stages == std::vector<Stage>{Stage::terra, Stage::jeep});
 
   // Progress names what runs, in order.
-  CHECK(stages_seen == std::vector<std::string>{"front_left terra", "front_left jeep",
-                                                "front_right terra", "front_right jeep",
-                                                "cycle front_left-front_right terra",
-                                                "cycle front_left-front_right jeep"});
+  CHECK(stages_seen == std::vector<std::string>{"lidar32 terra", "lidar32 jeep", "lidar16 terra",
+                                                "lidar16 jeep", "cycle lidar32-lidar16 terra",
+                                                "cycle lidar32-lidar16 jeep"});
 }
 
 TEST_CASE("a target the base barely sees is routed through one that sees both",

@@ -60,6 +60,7 @@ void check_same_evidence(const jeep::AcceptanceReport& ab, const jeep::Acceptanc
   CHECK(ab.agreeing == ba.agreeing);
   CHECK(ab.overlap == ba.overlap);
   CHECK(ab.condition == Approx(ba.condition).epsilon(1e-9));
+  CHECK(ab.directional_overlap == Approx(ba.directional_overlap).epsilon(1e-9));
 }
 
 }  // namespace

@@ -101,13 +101,14 @@ struct JeepReport {
   Isometry3d initial = Isometry3d::Identity();    ///< the extrinsic JEEP started from
   Isometry3d extrinsic = Isometry3d::Identity();  ///< JEEP's last extrinsic (even if failed)
   int rounds = 0;
-  std::size_t frame_pairs = 0;     ///< pairs used (<= JeepOptions::frames)
-  std::string calibration_status;  ///< of the last map-to-map registration
-  double final_cost = 0.0;         ///< of the last map-to-map registration
-  std::size_t final_inliers = 0;   ///< of the last map-to-map registration
-  double final_rmse = 0.0;         ///< m
-  bool accepted = false;           ///< the acceptance rule's verdict
-  double overlap = 0.0;            ///< acceptance: agreeing / near map points
+  std::size_t frame_pairs = 0;       ///< pairs used (<= JeepOptions::frames)
+  std::string calibration_status;    ///< of the last map-to-map registration
+  double final_cost = 0.0;           ///< of the last map-to-map registration
+  std::size_t final_inliers = 0;     ///< of the last map-to-map registration
+  double final_rmse = 0.0;           ///< m
+  bool accepted = false;             ///< the acceptance rule's verdict
+  double overlap = 0.0;              ///< acceptance: agreeing / near map points
+  double directional_overlap = 0.0;  ///< acceptance: the same, weakest direction (judged)
   /// Two-way step (jeep/two_way.hpp): applied, and how far the two directions disagreed.
   bool two_way = false;
   double two_way_gap_translation = 0.0;  ///< m

@@ -112,6 +112,7 @@ inline io::Json jeep_to_json(const JeepReport& r) {
   j["final_rmse_m"] = r.final_rmse;
   j["accepted"] = r.accepted;
   j["overlap"] = r.overlap;
+  j["directional_overlap"] = r.directional_overlap;
   j["two_way"] = r.two_way;
   j["two_way_gap_m"] = r.two_way_gap_translation;
   j["two_way_gap_deg"] = r.two_way_gap_rotation * result_detail::kDegPerRad;
