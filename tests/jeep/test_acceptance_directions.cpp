@@ -3,6 +3,7 @@
 // agree, and two samplings of the same place are accepted.
 #include <catch2/catch.hpp>
 #include <random>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -48,6 +49,14 @@ jeep::AcceptanceReport judge(const Points& a, const Points& b) {
                       jeep::AcceptanceOptions{});
 }
 
+/// The report's verdict and evidence, for a failing check's message.
+std::string evidence(const jeep::AcceptanceReport& r) {
+  std::ostringstream out;
+  out << r.reason << "; overlap " << r.overlap << ", directional " << r.directional_overlap
+      << ", condition " << r.condition;
+  return out.str();
+}
+
 }  // namespace
 
 TEST_CASE("acceptance accepts two samplings of one place", "[jeep][acceptance]") {
@@ -55,8 +64,7 @@ TEST_CASE("acceptance accepts two samplings of one place", "[jeep][acceptance]")
   const Points a = corner(10, 8, 0.0, rng);
   const Points b = corner(10, 8, 0.1, rng);
   const auto r = judge(a, b);
-  INFO(r.reason << "; overlap " << r.overlap << ", directional " << r.directional_overlap
-                << ", condition " << r.condition);
+  INFO(evidence(r));
   CHECK(r.accepted);
   CHECK(r.overlap > 0.9);
   CHECK(r.directional_overlap > 0.8);
@@ -72,8 +80,7 @@ TEST_CASE("acceptance refuses maps that agree on the ground but not on their wal
   // six directions (the patches), but along x and y most of the evidence disagrees.
   const Points b = corner(10.5, 8.5, 0.1, rng);
   const auto r = judge(a, b);
-  INFO(r.reason << "; overlap " << r.overlap << ", directional " << r.directional_overlap
-                << ", condition " << r.condition);
+  INFO(evidence(r));
   // The former rule (overlap >= 0.6, condition >= min_condition) would have accepted.
   CHECK(r.overlap > 0.6);
   CHECK(r.condition >= jeep::AcceptanceOptions{}.min_condition);
