@@ -37,9 +37,11 @@
 //     a JEEP that was rejected or did not settle hands its extrinsic to HOTS (hots_judges_jeep),
 //     and when the attempt from TERRA's best rotation fails in a way that points at the
 //     rotation (JEEP failed, or HOTS's extrinsic_unconfirmed), TERRA's next distinct optima run
-//     in turn (terra_hypotheses); the first success wins. With none, the best one's failure is
-//     reported. stages.terra.hypotheses lists each one tried and its outcome; timings sum
-//     over all of them.
+//     in turn (terra_hypotheses); the first success wins. When all of those fail, up to
+//     terra_fallback_hypotheses more (the kept search's other optima, then those of the search
+//     not kept) run, each needing JEEP's own acceptance before HOTS. With none, the best one's
+//     failure is reported. stages.terra.hypotheses lists each one tried and its outcome; timings
+//     sum over all of them.
 //   - Progress: options.progress(stage, fraction in [0, 1]) on the calling thread; stages
 //     "terra", "jeep", "odometry", "hots" (HOTS reports only 0 and 1); a later hypothesis's
 //     stages carry " (hypothesis k)".
@@ -110,6 +112,12 @@ struct CalibrateOptions {
   /// the search's next distinct optima are tried in turn, up to this many in all; the first
   /// success wins. 1 = the paper's single answer. Not in the paper.
   std::size_t terra_hypotheses = 4;
+  /// ... and when all of those fail, up to this many more (terra_hypotheses.hpp,
+  /// fallback_hypotheses): the kept search's remaining optima, then the other search's when
+  /// both ran. Each must pass JEEP's own acceptance before HOTS runs from it (no hand-over:
+  /// lower-ranked optima get the stricter test, and a refused one costs JEEP alone, 1-4 s).
+  /// 0 = none. Not in the paper.
+  std::size_t terra_fallback_hypotheses = 8;
   /// Optima closer than this to a better one are the same hypothesis (JEEP converges from a few
   /// degrees).
   double terra_hypothesis_separation_deg = 10.0;
@@ -150,8 +158,9 @@ struct StageOutcome {
   bool points_at_start = false;
 };
 
-inline TerraHypothesis hypothesis_entry(const terra::RotationCandidate& c) {
+inline TerraHypothesis hypothesis_entry(const terra::RotationCandidate& c, std::string source) {
   TerraHypothesis h;
+  h.source = std::move(source);
   h.rotation = c.rotation;
   h.distance = c.distance;
   h.mask_count = c.mask_count;
@@ -212,11 +221,12 @@ inline TerraReport terra_report(const terra::SearchResult& s, std::size_t frame_
 }
 
 /// The TERRA stage's path choice (CalibrateOptions::terra_source): fills r.terra (all but
-/// seconds) and returns the kept search.
+/// seconds) and returns the kept search; `other` gets the search not kept when both ran.
 template <class FramesA, class FramesB>
 terra::SearchResult terra_stage(const FramesA& frames_a, const std::vector<double>& times_a,
                                 const FramesB& frames_b, const std::vector<double>& times_b,
-                                const CalibrateOptions& options, PairCalibration& r) {
+                                const CalibrateOptions& options, PairCalibration& r,
+                                terra::SearchResult& other) {
   const CalibrateProgress& report = options.progress;
   const std::size_t i = options.frame_index;
   const terra::SearchParams& params = options.terra;
@@ -293,6 +303,7 @@ terra::SearchResult terra_stage(const FramesA& frames_a, const std::vector<doubl
               "automatic: " + frames_said + "; the maps in " + std::to_string(m.search.mask_count));
     r.terra->frames_mask_count = f.mask_count;
     r.terra->frames_status = terra::to_string(f.status);
+    other = f;
     return m.search;
   }
   keep_frames(f, "automatic: " + frames_said + ", but the map search " +
@@ -300,6 +311,7 @@ terra::SearchResult terra_stage(const FramesA& frames_a, const std::vector<doubl
                              : std::string("failed: ") + m.search.reason));
   r.terra->base_map = m.base;
   r.terra->target_map = m.target;
+  other = m.search;
   return f;
 }
 
@@ -438,10 +450,13 @@ PairCalibration calibrate_pair(const FramesA& frames_a, const std::vector<double
   const Isometry3d start_guess = run_terra ? Isometry3d::Identity() : *options.initial;
   r.T_base_target = start_guess;
   std::vector<terra::RotationCandidate> hypotheses;
+  std::size_t first_fallback = 0;  // hypotheses from here on are the fallback's
+  std::vector<std::string> sources;
   if (run_terra) {
     const auto t0 = std::chrono::steady_clock::now();
+    terra::SearchResult other;
     const terra::SearchResult s =
-        calibrate_detail::terra_stage(frames_a, times_a, frames_b, times_b, options, r);
+        calibrate_detail::terra_stage(frames_a, times_a, frames_b, times_b, options, r, other);
     r.terra->seconds = seconds_since(t0);
     report("terra", 1.0);  // the map search may not have run after the frames' share
     r.timing_s.terra = r.terra->seconds;
@@ -449,13 +464,26 @@ PairCalibration calibrate_pair(const FramesA& frames_a, const std::vector<double
       return finish(CalibrateStatus::terra_failed, std::string("TERRA: ") +
                                                        terra::to_string(s.status) + ": " +
                                                        s.reason + " (on " + r.terra->source + ")");
+    const double separation =
+        options.terra_hypothesis_separation_deg * calibrate_detail::kRadPerDeg;
     hypotheses =
-        terra_hypotheses(s, std::max<std::size_t>(1, options.terra_hypotheses),
-                         options.terra_hypothesis_separation_deg * calibrate_detail::kRadPerDeg);
+        terra_hypotheses(s, std::max<std::size_t>(1, options.terra_hypotheses), separation);
+    first_fallback = hypotheses.size();
+    sources.assign(hypotheses.size(), r.terra->source);
+    const std::string other_source = r.terra->source == "maps" ? "frames" : "maps";
+    for (const terra::SearchResult* search : {&s, static_cast<const terra::SearchResult*>(&other)})
+      for (const auto& c : fallback_hypotheses(
+               *search, hypotheses,
+               options.terra_fallback_hypotheses - (hypotheses.size() - first_fallback),
+               separation)) {
+        hypotheses.push_back(c);
+        sources.push_back(search == &s ? r.terra->source : other_source);
+      }
   }
   if (!run_jeep && !run_hots) {
     r.T_base_target.linear() = hypotheses.front().rotation;
-    r.terra->hypotheses.push_back(calibrate_detail::hypothesis_entry(hypotheses.front()));
+    r.terra->hypotheses.push_back(
+        calibrate_detail::hypothesis_entry(hypotheses.front(), sources.front()));
     r.terra->hypotheses.back().outcome = "ok";
     return finish(CalibrateStatus::ok, "");
   }
@@ -465,7 +493,7 @@ PairCalibration calibrate_pair(const FramesA& frames_a, const std::vector<double
   const std::vector<double> ta = times_from(times_a, i), tb = times_from(times_b, i);
   // HOTS can judge a start: it runs, on a moving rig.
   const bool can_verify = run_hots && frames_left >= options.hots_min_frames;
-  auto run_from = [&](const Isometry3d& start, const std::string& label,
+  auto run_from = [&](const Isometry3d& start, const std::string& label, bool hots_may_judge,
                       PairCalibration& out) -> StageOutcome {
     auto stage = [&](const char* name) { return label.empty() ? name : name + label; };
     std::string jeep_failure;  // set when JEEP failed and HOTS judges its extrinsic
@@ -491,8 +519,8 @@ PairCalibration calibrate_pair(const FramesA& frames_a, const std::vector<double
       report(stage("jeep"), 1.0);
       if (!j.ok()) {
         jeep_failure = std::string("JEEP: ") + jeep::to_string(j.status) + ": " + j.reason;
-        out.jeep->judged_by_hots =
-            options.hots_judges_jeep && can_verify && calibrate_detail::hots_can_judge(j);
+        out.jeep->judged_by_hots = hots_may_judge && options.hots_judges_jeep && can_verify &&
+                                   calibrate_detail::hots_can_judge(j);
         if (!out.jeep->judged_by_hots) return {CalibrateStatus::jeep_failed, jeep_failure, true};
       }
       C = j.extrinsic;
@@ -546,7 +574,7 @@ PairCalibration calibrate_pair(const FramesA& frames_a, const std::vector<double
   };
 
   if (!run_terra) {
-    const StageOutcome o = run_from(start_guess, "", r);
+    const StageOutcome o = run_from(start_guess, "", true, r);
     return finish(o.status, o.reason);
   }
 
@@ -559,11 +587,11 @@ PairCalibration calibrate_pair(const FramesA& frames_a, const std::vector<double
     const auto t0 = std::chrono::steady_clock::now();
     Isometry3d start = Isometry3d::Identity();
     start.linear() = hypotheses[k].rotation;
-    TerraHypothesis entry = calibrate_detail::hypothesis_entry(hypotheses[k]);
+    TerraHypothesis entry = calibrate_detail::hypothesis_entry(hypotheses[k], sources[k]);
     const std::string label = k == 0 ? "" : " (hypothesis " + std::to_string(k + 1) + ")";
     PairCalibration attempt;
     attempt.time_offset_s = r.time_offset_s;
-    const StageOutcome o = run_from(start, label, attempt);
+    const StageOutcome o = run_from(start, label, k < first_fallback, attempt);
     entry.outcome = o.status == CalibrateStatus::ok
                         ? std::string("ok")
                         : std::string(to_string(o.status)) + ": " + o.reason;

@@ -25,6 +25,7 @@ TEST_CASE("when HOTS refuses every start, TERRA's next hypotheses are tried and 
   o.time_offset_s = 0.0;
   // A judge nothing can satisfy: every start ends extrinsic_unconfirmed.
   o.hots.min_cross_links = std::numeric_limits<std::size_t>::max();
+  o.terra_fallback_hypotheses = 2;  // two of the fallback's, to keep the test short
   std::vector<std::string> stages_seen;
   o.progress = record_stages(stages_seen);
   const auto c = ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, o);
@@ -33,14 +34,20 @@ TEST_CASE("when HOTS refuses every start, TERRA's next hypotheses are tried and 
   REQUIRE(c.terra);
   const auto& tried = c.terra->hypotheses;
   REQUIRE(tried.size() >= 2);
-  CHECK(tried.size() <= o.terra_hypotheses);
-  // Best first (TERRA's own answer), distances in order, distinct basins.
+  CHECK(tried.size() <= o.terra_hypotheses + o.terra_fallback_hypotheses);
+  // Best first (TERRA's own answer), the search's optima by distance, then the fallback's;
+  // distinct basins throughout.
   CHECK(tried[0].rotation.isApprox(c.terra->rotation));
+  const std::size_t primary = std::min(tried.size(), o.terra_hypotheses);
   for (std::size_t k = 0; k < tried.size(); ++k) {
-    INFO("hypothesis " << k << ": " << tried[k].outcome);
+    INFO("hypothesis " << k << " (" << tried[k].source << "): " << tried[k].outcome);
     CHECK((tried[k].outcome.find("extrinsic_unconfirmed") != std::string::npos ||
            tried[k].outcome.find("jeep_failed") != std::string::npos));
-    if (k > 0) CHECK(tried[k - 1].distance <= tried[k].distance);
+    if (k < primary) CHECK(tried[k].source == c.terra->source);
+    // The fallback's need JEEP's own acceptance: a refused JEEP is not handed to HOTS.
+    if (k >= primary && tried[k].outcome.find("jeep_failed") != std::string::npos)
+      CHECK_THAT(tried[k].outcome, !Catch::Contains("HOTS, run from its extrinsic"));
+    if (k > 0 && k < primary) CHECK(tried[k - 1].distance <= tried[k].distance);
     for (std::size_t m = 0; m < k; ++m)
       CHECK(ulc::rotation_error_rad(tried[m].rotation, tried[k].rotation) >=
             o.terra_hypothesis_separation_deg * kDeg);
@@ -54,10 +61,13 @@ TEST_CASE("when HOTS refuses every start, TERRA's next hypotheses are tried and 
         stages_seen.end());
   const auto entry = ulc::to_pair_result(c, "lidar64", "lidar32");
   CHECK(entry.stages.at("terra").at("hypotheses").size() == tried.size());
+  CHECK(entry.stages.at("terra").at("hypotheses")[std::size_t{0}].at("source").as_string() ==
+        c.terra->source);
   CHECK(entry.stages.at("terra").at("hypothesis_used").as_number() == 0.0);
 
-  // One hypothesis: the paper's single answer, and nothing else is tried.
+  // One hypothesis and no fallback: the paper's single answer, and nothing else is tried.
   o.terra_hypotheses = 1;
+  o.terra_fallback_hypotheses = 0;
   const auto single = ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, o);
   REQUIRE(single.terra);
   CHECK(single.terra->hypotheses.size() == 1);

@@ -73,3 +73,26 @@ TEST_CASE("a failed search has no hypothesis", "[calibrate][terra_hypotheses]") 
   s.status = terra::SearchStatus::no_overlap;
   CHECK(ulc::terra_hypotheses(s, 4, 10.0 * kDeg).empty());
 }
+
+TEST_CASE("the fallback takes the optima not yet tried, in the search's order, one per basin",
+          "[calibrate][terra_hypotheses]") {
+  const terra::SearchResult s =
+      search_with({candidate(166.0, 0.004), candidate(8.0, 0.003), candidate(2.0, 0.005),
+                   candidate(-60.0, 0.006), candidate(100.0, 0.006), candidate(-55.0, 0.007)});
+  // Tried already: TERRA's best (8 deg) and something 3 deg from the 100-deg optimum.
+  const std::vector<terra::RotationCandidate> tried{candidate(8.0, 0.003), candidate(103.0, 0.01)};
+  const auto yaws = yaws_of(ulc::fallback_hypotheses(s, tried, 10, 10.0 * kDeg));
+  // 2 deg is 8's basin, 100 deg is the tried 103's, -55 deg is -60's.
+  REQUIRE(yaws.size() == 2);
+  CHECK(yaws[0] == Approx(166.0));
+  CHECK(yaws[1] == Approx(-60.0));
+  CHECK(ulc::fallback_hypotheses(s, tried, 1, 10.0 * kDeg).size() == 1);
+  CHECK(ulc::fallback_hypotheses(s, tried, 0, 10.0 * kDeg).empty());
+  // Nothing tried yet: the same list as terra_hypotheses.
+  const auto all = yaws_of(ulc::fallback_hypotheses(s, {}, 10, 10.0 * kDeg));
+  CHECK(all == yaws_of(ulc::terra_hypotheses(s, 10, 10.0 * kDeg)));
+
+  terra::SearchResult failed = s;
+  failed.status = terra::SearchStatus::no_overlap;
+  CHECK(ulc::fallback_hypotheses(failed, {}, 10, 10.0 * kDeg).empty());
+}

@@ -59,6 +59,7 @@ inline const char* to_string(CalibrateStatus s) {
 /// One of TERRA's hypotheses the pipeline started from (terra_hypotheses.hpp) and what became of
 /// it.
 struct TerraHypothesis {
+  std::string source = "frames";       ///< "frames" or "maps": the search it is an optimum of
   Mat3d rotation = Mat3d::Identity();  ///< R_base_target
   double distance = 0.0;               ///< eq:feature_dis
   std::size_t mask_count = 0;          ///< eq:mask cells

@@ -86,6 +86,7 @@ inline io::Json terra_to_json(const TerraReport& t) {
   io::Json hypotheses = io::Json::array();
   for (const TerraHypothesis& h : t.hypotheses) {
     io::Json e = io::Json::object();
+    e["source"] = h.source;
     e["rpy_deg"] = io::vector_to_json(rpy_from_rotation(h.rotation) * result_detail::kDegPerRad);
     e["distance"] = h.distance;
     e["mask_count"] = h.mask_count;

@@ -10,6 +10,15 @@
 // and orders them by (distance, seed rank), the search's own choice rule, so the first is
 // always SearchResult::rotation.
 //
+// The fallback (fallback_hypotheses): when every one of those fails, the optima left over, of
+// the kept search beyond the first few and then of the other search (automatic runs the frame
+// search first and keeps the maps only when the frames overlap little, so both may exist; the
+// caller chains the two), in each search's own order, without those within `separation_rad`
+// of one already tried. Why:
+// on the 90-deg-pitched VLP-16 (pitched-90, seed 1, 10 s) the map search's five optima are all
+// 74-153 deg off, while the frame search's seventh is 3.2 deg off and leads JEEP and HOTS to
+// 0.016 deg / 0.31 cm (docs/BENCHMARKS.md, "TERRA's fallback hypotheses").
+//
 // Nothing here throws; deterministic (ordered comparisons only).
 #pragma once
 
@@ -49,6 +58,26 @@ inline std::vector<terra::RotationCandidate> terra_hypotheses(const terra::Searc
     best.distance = search.distance;
     best.mask_count = search.mask_count;
     out.push_back(best);
+  }
+  return out;
+}
+
+/// Up to `max_count` optima of `search`, in its own order, none within `separation_rad` of one
+/// in `tried` or of one taken before it.
+inline std::vector<terra::RotationCandidate> fallback_hypotheses(
+    const terra::SearchResult& search, const std::vector<terra::RotationCandidate>& tried,
+    std::size_t max_count, double separation_rad) {
+  std::vector<terra::RotationCandidate> out;
+  if (!search.ok()) return out;
+  std::vector<terra::RotationCandidate> kept = tried;
+  for (const auto& c : terra_hypotheses(search, search.refined.size(), separation_rad)) {
+    if (out.size() >= max_count) break;
+    const bool distinct = std::none_of(kept.begin(), kept.end(), [&](const auto& k) {
+      return rotation_error_rad(k.rotation, c.rotation) < separation_rad;
+    });
+    if (!distinct) continue;
+    out.push_back(c);
+    kept.push_back(c);
   }
   return out;
 }
