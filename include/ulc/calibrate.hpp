@@ -114,8 +114,9 @@ struct CalibrateOptions {
   std::size_t terra_hypotheses = 4;
   /// ... and when all of those fail, up to this many more (terra_hypotheses.hpp,
   /// fallback_hypotheses): the kept search's remaining optima, then the other search's when
-  /// both ran. Each must pass JEEP's own acceptance before HOTS runs from it (no hand-over:
-  /// lower-ranked optima get the stricter test, and a refused one costs JEEP alone, 1-4 s).
+  /// both ran. With jeep among the stages, each must pass JEEP's own acceptance before HOTS
+  /// runs from it (no hand-over: lower-ranked optima get the stricter test, and a refused one
+  /// costs JEEP alone, 1-4 s); HOTS's cross links judge every one.
   /// 0 = none. Not in the paper.
   std::size_t terra_fallback_hypotheses = 8;
   /// Optima closer than this to a better one are the same hypothesis (JEEP converges from a few
