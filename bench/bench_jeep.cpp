@@ -7,8 +7,10 @@
 //   bench_jeep --robustness [--scenarios 64-32,64-horizon] [--starts 3] [--png DIR]
 //   bench_jeep --frames-sweep [--scenarios 64-32,64-horizon,64-tele] [--starts 5] [--png DIR]
 //   bench_jeep --odometry   [--seconds 20] [--repeats 1]
-//   common: [--seconds 20] [--seed 1] [--threads 2] [--cache DIR] [--one-way] [--json]
+//   common: [--seconds 20] [--seed 1] [--threads 2] [--cache DIR] [--one-way]
+//           [--second-look] [--json]
 //   --one-way: JEEP without its two-way step (jeep/two_way.hpp), the earlier behaviour.
+//   --second-look: JEEP with the second look at sparse pairs (jeep/second_look.hpp; opt-in).
 //
 // (a) accuracy, the paper's protocol: the ground truth disturbed by 5 deg about a random axis
 //     and 2 m in a random direction (seeded per start), at --starts windows spread evenly along
@@ -66,8 +68,9 @@ struct Config {
   std::uint64_t seed = 1;
   int threads = 2;
   std::string cache = "/tmp/ulc_jeep_cache";
-  std::string png_dir;   ///< --png DIR: robustness and frames-sweep heat maps as PNG
-  bool one_way = false;  ///< --one-way: JEEP without the two-way step
+  std::string png_dir;       ///< --png DIR: robustness and frames-sweep heat maps as PNG
+  bool one_way = false;      ///< --one-way: JEEP without the two-way step
+  bool second_look = false;  ///< --second-look: a second look at refusals (opt-in)
   ulc_bench::Options bench;
 };
 
@@ -76,6 +79,7 @@ jeep::JeepOptions jeep_options(const Config& c, std::size_t frames) {
   jeep::JeepOptions o;
   o.frames = frames;
   o.two_way = !c.one_way;
+  o.second_look.enabled = c.second_look;
   return o;
 }
 
@@ -167,6 +171,7 @@ struct Outcome {
   double overlap = 0.0;
   double directional_overlap = 0.0;
   double condition = 0.0;
+  bool by_second_look = false;  ///< accepted by the second look (jeep/second_look.hpp)
   int rounds = 0;
 };
 
@@ -176,11 +181,13 @@ bool success(const Outcome& o) {
 
 struct Summary {
   std::size_t runs = 0, successes = 0, accepted = 0, false_accepts = 0, within = 0;
+  std::size_t by_second_look = 0;
   std::vector<double> rot, trans, time, rounds;
   void add(const Outcome& o) {
     ++runs;
     successes += success(o) ? 1 : 0;
     accepted += o.ok ? 1 : 0;
+    by_second_look += o.ok && o.by_second_look ? 1 : 0;
     false_accepts += o.ok && !ulc::is_calibration_success(o.error) ? 1 : 0;
     within += ulc::is_calibration_success(o.error) ? 1 : 0;
     rot.push_back(o.error.rotation_deg);
@@ -204,6 +211,7 @@ Outcome run_jeep(const Window& w, const Isometry3d& initial, const Isometry3d& t
   out.overlap = r.acceptance.overlap;
   out.directional_overlap = r.acceptance.directional_overlap;
   out.condition = r.acceptance.condition;
+  out.by_second_look = r.second_look.passed;
   out.rounds = r.rounds;
   return out;
 }
@@ -245,8 +253,9 @@ void accuracy(Config c) {
     c.scenarios = {"64-32", "32-16", "horizon-tele", "64-horizon", "32-avia", "64-tele"};
   if (!c.starts) c.starts = 50;
   ulc_bench::Table table({"scenario", "method", "runs", "success_pct", "accepted_pct",
-                          "false_accepts", "median_e_rot_deg", "median_e_trans_cm", "p90_e_rot_deg",
-                          "p90_e_trans_cm", "median_rounds", "median_time_s"});
+                          "false_accepts", "by_second_look", "median_e_rot_deg",
+                          "median_e_trans_cm", "p90_e_rot_deg", "p90_e_trans_cm", "median_rounds",
+                          "median_time_s"});
   const jeep::JeepOptions o = jeep_options(c, c.frames);
   for (const auto& scenario : c.scenarios) {
     const Drive d = load_drive(scenario, c);
@@ -272,6 +281,7 @@ void accuracy(Config c) {
                      Cell::integer(static_cast<long long>(sum->runs)),
                      Cell::num(sum->pct(sum->successes), 1), Cell::num(sum->pct(sum->accepted), 1),
                      Cell::integer(static_cast<long long>(sum->false_accepts)),
+                     Cell::integer(static_cast<long long>(sum->by_second_look)),
                      Cell::num(jeep_test::median(sum->rot), 4),
                      Cell::num(100 * jeep_test::median(sum->trans), 2), Cell::num(p90(sum->rot), 4),
                      Cell::num(100 * p90(sum->trans), 2),
@@ -298,16 +308,16 @@ void separation(Config c) {
   if (c.scenarios.empty())
     c.scenarios = {"64-32", "32-16", "horizon-tele", "64-horizon", "32-avia", "64-tele"};
   if (!c.starts) c.starts = 10;
-  ulc_bench::Table table({"scenario", "data", "runs", "settled", "accepted_pct", "overlap_median",
-                          "overlap_max", "dir_overlap_min", "dir_overlap_median", "dir_overlap_max",
-                          "condition_min"});
+  ulc_bench::Table table({"scenario", "data", "runs", "settled", "accepted_pct", "by_second_look",
+                          "overlap_median", "overlap_max", "dir_overlap_min", "dir_overlap_median",
+                          "dir_overlap_max", "condition_min"});
   const jeep::JeepOptions o = jeep_options(c, c.frames);
   for (const auto& scenario : c.scenarios) {
     const Drive d = load_drive(scenario, c);
     const std::size_t half = d.pairs.size() / 2;
     for (int unrelated = 0; unrelated < 2; ++unrelated) {
       std::vector<double> overlap, directional, condition;
-      std::size_t accepted = 0, runs = 0;
+      std::size_t accepted = 0, runs = 0, by_second_look = 0;
       for (std::size_t s : start_pairs(d, c.starts, c.frames)) {
         // Unrelated: b's frames from half a drive away (another street), a's timestamps.
         std::size_t b_first = SIZE_MAX;
@@ -316,6 +326,7 @@ void separation(Config c) {
         const Outcome r = run_jeep(window(d, s, c.frames, b_first), initial, d.truth, o, c.threads);
         ++runs;
         accepted += r.ok ? 1 : 0;
+        by_second_look += r.ok && r.by_second_look ? 1 : 0;
         // The rule judges settled runs only; a true run that settled away from the truth is
         // not evidence of what the truth looks like.
         const bool settled = r.status == "ok" || r.status == "rejected";
@@ -334,24 +345,26 @@ void separation(Config c) {
                      Cell::integer(static_cast<long long>(runs)),
                      Cell::integer(static_cast<long long>(overlap.size())),
                      Cell::num(runs ? 100.0 * accepted / runs : 0.0, 1),
+                     Cell::integer(static_cast<long long>(by_second_look)),
                      Cell::num(jeep_test::median(overlap), 3), Cell::num(mx(overlap), 3),
                      Cell::num(mn(directional), 3), Cell::num(jeep_test::median(directional), 3),
                      Cell::num(mx(directional), 3), Cell::num(mn(condition), 4)});
     }
   }
-  emit(table, "bench_jeep_separation", c,
-       {{"scenarios", scenario_list(c)},
-        {"starts", Cell::integer(static_cast<long long>(c.starts))},
-        {"frames", Cell::integer(static_cast<long long>(c.frames))}},
-       {{"settled",
-         "runs the rule judged (status ok or rejected); true data: and within the "
-         "success bounds; the statistics are over these"},
-        {"overlap", "agreeing / near points of the smaller map (acceptance.hpp)"},
-        {"dir_overlap", "agreeing share of the near points' information in the weakest direction"},
-        {"rule",
-         "accept iff dir_overlap >= " +
-             std::to_string(jeep::AcceptanceOptions{}.min_directional_overlap) +
-             " and condition >= " + std::to_string(jeep::AcceptanceOptions{}.min_condition)}});
+  emit(
+      table, "bench_jeep_separation", c,
+      {{"scenarios", scenario_list(c)},
+       {"starts", Cell::integer(static_cast<long long>(c.starts))},
+       {"frames", Cell::integer(static_cast<long long>(c.frames))}},
+      {{"settled",
+        "runs the rule judged (status ok or rejected); true data: and within the "
+        "success bounds; the statistics are over these"},
+       {"overlap", "agreeing / near points of the smaller map (acceptance.hpp)"},
+       {"dir_overlap", "agreeing share of the near points' information in the weakest direction"},
+       {"rule", "accept iff dir_overlap >= " +
+                    std::to_string(jeep::AcceptanceOptions{}.min_directional_overlap) +
+                    " and condition >= " + std::to_string(jeep::AcceptanceOptions{}.min_condition) +
+                    (c.second_look ? ", or by the second look (jeep/second_look.hpp)" : "")}});
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -615,7 +628,8 @@ int main(int argc, char** argv) {
       .value("--threads", ulc_bench::at_least(c.threads, 1))
       .value("--cache", ulc_bench::text(c.cache))
       .value("--png", ulc_bench::text(c.png_dir))
-      .flag("--one-way", [&] { c.one_way = true; });
+      .flag("--one-way", [&] { c.one_way = true; })
+      .flag("--second-look", [&] { c.second_look = true; });
   c.bench = args.parse(argc, argv,
                        "JEEP, scan-scan, odometry and ICP on simulated drives (modes: --accuracy "
                        "--separation --robustness --frames-sweep --odometry --registration)");

@@ -4,10 +4,12 @@
 //
 //   bench_rig [--scenarios ring-5x16,pitched-90,side-bpearl] [--seconds 10]
 //             [--stages terra,jeep,hots] [--decimation 1] [--seed 1] [--threads 2]
-//             [--no-route] [--no-cycles] [--synced-clocks] [--json]
+//             [--no-route] [--no-cycles] [--synced-clocks] [--second-look] [--json]
 // --synced-clocks: the pairs are told their clocks agree (the simulated rigs' do), so HOTS
 // neither estimates nor checks an offset; without it, a drive too short to pin the offset down
 // fails with time_offset_untrusted.
+// --second-look: JEEP's opt-in second look at refusals for the directional overlap alone
+// (include/jeep/second_look.hpp), for the pairs and the cycle checks.
 //
 // Per target: e_rot (deg) and e_trans (cm) against the simulator's mounts, the calibration's
 // status, the route, the clock offset error when HOTS ran, the cross links of the kept result
@@ -45,6 +47,7 @@ struct Config {
   bool route = true;
   bool cycles = true;
   bool synced_clocks = false;  ///< --synced-clocks: no clock offset estimated (the rigs share one)
+  bool second_look = false;    ///< --second-look: JEEP's second look (opt-in)
   ulc_bench::Options bench;
 };
 
@@ -91,6 +94,7 @@ void bench(const Config& c) {
     ulc::RigOptions o;
     o.pair.stages = stages.stages;
     if (c.synced_clocks) o.pair.time_offset_s = 0.0;
+    o.pair.jeep.second_look.enabled = c.second_look;
     o.route = c.route;
     o.cycles = c.cycles;
     if (!c.bench.json)
@@ -185,10 +189,12 @@ int main(int argc, char** argv) {
       .value("--threads", ulc_bench::at_least(c.threads, 1))
       .flag("--no-route", [&] { c.route = false; })
       .flag("--no-cycles", [&] { c.cycles = false; })
-      .flag("--synced-clocks", [&] { c.synced_clocks = true; });
+      .flag("--synced-clocks", [&] { c.synced_clocks = true; })
+      .flag("--second-look", [&] { c.second_look = true; });
   c.bench = args.parse(argc, argv,
                        "whole rigs with no initial guess (options --scenarios --seconds --stages "
-                       "--decimation --seed --threads --no-route --no-cycles --synced-clocks)");
+                       "--decimation --seed --threads --no-route --no-cycles --synced-clocks "
+                       "--second-look)");
   bench(c);
   return 0;
 }

@@ -167,6 +167,10 @@ int run_calibrate(int argc, char** argv) {
             "(for short drives that cannot pin one down)")
       .flag("no-route",
             "do not calibrate a failed target through another target that did calibrate")
+      .flag("second-look",
+            "JEEP: give a refusal for the directional overlap alone a second look (both "
+            "registration directions agree, and starts around the result come back to it); "
+            "accepts more sparse pairs (VLP-16, Avia), at a small risk of accepting a wrong fit")
       .flag("no-cycles", "do not check the cycles base -> i -> j -> base (two targets or more)")
       .flag("quiet", "no progress on stderr")
       .flag("help", "show this help");
@@ -201,6 +205,7 @@ int run_calibrate(int argc, char** argv) {
                           " needs an initial extrinsic: --initial \"x y z roll pitch yaw\" or "
                           "--initial FILE.json");
   if (args.has("synced-clocks")) options.time_offset_s = 0.0;
+  options.jeep.second_look.enabled = args.has("second-look");
   const auto frame_index =
       static_cast<std::size_t>(args.get_int("frame-index", 0, 0, 1000000000LL));
   options.jeep.frames = static_cast<std::size_t>(

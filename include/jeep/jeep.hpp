@@ -18,7 +18,8 @@
 //   - Settled: the round changed C by less than settle_translation / settle_rotation and every
 //     pose of a by less than the same. No settling within max_rounds (the paper: "exceeding a
 //     certain number of iterations is a failure"; 10) gives status not_converged.
-//   - Acceptance (status rejected otherwise), see acceptance.hpp.
+//   - Acceptance (status rejected otherwise), see acceptance.hpp; optionally with a second
+//     look at a refusal for the directional overlap alone (second_look.hpp).
 //   - Nothing here throws or prints; the result is the same for any number of threads.
 #pragma once
 
@@ -35,6 +36,7 @@
 #include "jeep/odometry.hpp"
 #include "jeep/run_odometry.hpp"
 #include "jeep/scan_preparation.hpp"
+#include "jeep/second_look.hpp"
 #include "jeep/start_search.hpp"
 #include "jeep/two_way.hpp"
 #include "ulc/core/lie.hpp"
@@ -58,6 +60,8 @@ struct JeepOptions {
   double settle_translation = 0.005;  ///< m
   double settle_rotation = 3.5e-4;    ///< rad (0.02 deg)
   AcceptanceOptions acceptance;
+  /// Opt-in: a refusal for the directional overlap alone gets a second look (second_look.hpp).
+  SecondLookOptions second_look;
   /// Frame period when the timestamps cannot tell (a single frame): DESIGN.md's 10 Hz.
   double default_period = 0.1;
   /// Once settled, meet map a registered to map b's planes halfway (two_way.hpp), so that
@@ -113,7 +117,8 @@ struct JeepResult {
   int rounds = 0;
   RegistrationResult<double> calibration;  ///< the last calibration phase
   StartSearchReport start_search;          ///< the first calibration phase's start search
-  AcceptanceReport acceptance;
+  AcceptanceReport acceptance;             ///< accepted: by the rule or by the second look
+  SecondLookReport second_look;
   TwoWayResult two_way;  ///< the last step when JeepOptions::two_way (applied: it was used)
   std::vector<JeepRound> trace;
   /// The last round's maps (eq:build_map) at calibration.target_voxel, in the frames of
@@ -285,6 +290,11 @@ JeepResult run_jeep(const FramesA& frames_a, const std::vector<double>& times_a,
     }
     if (settled || round == options.max_rounds) {
       result.acceptance = assess(map_a, map_b, target, options.calibration, C, options.acceptance);
+      if (qualifies_for_second_look(result.acceptance, options.acceptance, options.second_look)) {
+        result.second_look = second_look(map_b, target, C, result.two_way, options.calibration,
+                                         options.start_search, options.second_look);
+        result.acceptance.accepted = result.second_look.passed;
+      }
       // In the output poses' frames (see to_first below).
       const Isometry3d to_first = poses_a[0].inverse();
       const Isometry3d to_first_b = C.inverse() * to_first * C;
@@ -300,7 +310,9 @@ JeepResult run_jeep(const FramesA& frames_a, const std::vector<double>& times_a,
   if (result.trace.back().failed_steps > 0)
     return fail(JeepStatus::registration_failed,
                 "a pose-phase step had too few correspondences in the last round");
-  if (!result.acceptance.accepted) return fail(JeepStatus::rejected, result.acceptance.reason);
+  if (!result.acceptance.accepted)
+    return fail(JeepStatus::rejected,
+                result.second_look.ran ? result.second_look.reason : result.acceptance.reason);
   return result;
 }
 

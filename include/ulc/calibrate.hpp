@@ -337,6 +337,10 @@ inline JeepReport jeep_report(const jeep::JeepResult& j, const Isometry3d& initi
   r.two_way_gap_rotation = j.two_way.gap_rotation;
   r.start_basins = j.start_search.basins;
   r.start_chosen = j.start_search.chosen;
+  r.second_look = j.second_look.ran;
+  r.second_look_passed = j.second_look.passed;
+  r.second_look_returned = j.second_look.returned;
+  r.second_look_starts = j.second_look.starts;
   r.seconds = seconds;
   return r;
 }

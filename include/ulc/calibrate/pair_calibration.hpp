@@ -118,6 +118,12 @@ struct JeepReport {
   /// scored, and the start whose basin won (0: the initial extrinsic's own).
   std::size_t start_basins = 0;
   std::size_t start_chosen = 0;
+  /// The second look at a refusal for the directional overlap alone (jeep/second_look.hpp):
+  /// whether it ran, and how many of its starts came back to the extrinsic.
+  bool second_look = false;
+  bool second_look_passed = false;
+  std::size_t second_look_returned = 0;
+  std::size_t second_look_starts = 0;
   /// JEEP failed (rejected or not settled) and HOTS ran from its extrinsic to judge it
   /// (CalibrateOptions::hots_judges_jeep): the pair's status says which won.
   bool judged_by_hots = false;

@@ -119,6 +119,15 @@ inline io::Json jeep_to_json(const JeepReport& r) {
   j["two_way_gap_deg"] = r.two_way_gap_rotation * result_detail::kDegPerRad;
   j["start_basins"] = r.start_basins;
   j["start_chosen"] = r.start_chosen;
+  if (r.second_look) {
+    io::Json look = io::Json::object();
+    look["passed"] = r.second_look_passed;
+    look["returned"] = r.second_look_returned;
+    look["starts"] = r.second_look_starts;
+    j["second_look"] = look;
+  } else {
+    j["second_look"] = nullptr;
+  }
   j["judged_by_hots"] = r.judged_by_hots;
   j["seconds"] = r.seconds;
   return j;
