@@ -8,22 +8,13 @@
 
 #include "jeep/second_look.hpp"
 #include "jeep/two_way.hpp"
+#include "surface_samples.hpp"
 
 namespace {
 
-using Points = std::vector<ulc::Vec3<double>>;
+using jeep_test::add_rectangle;
+using Points = jeep_test::SurfacePoints;
 using ulc::Isometry3d;
-
-/// Samples the rectangle origin + u * [0, lu] + v * [0, lv] every `step` from `phase`, with
-/// 1 cm of noise along its normal.
-void add_rectangle(Points& out, const ulc::Vec3d& origin, const ulc::Vec3d& u, double lu,
-                   const ulc::Vec3d& v, double lv, double step, double phase, std::mt19937& rng) {
-  std::normal_distribution<double> noise(0.0, 0.01);
-  const ulc::Vec3d n = u.cross(v).normalized();
-  for (double a = phase; a < lu; a += step)
-    for (double b = phase; b < lv; b += step)
-      out.push_back(origin + a * u + b * v + noise(rng) * n);
-}
 
 const ulc::Vec3d kX = ulc::Vec3d::UnitX(), kY = ulc::Vec3d::UnitY(), kZ = ulc::Vec3d::UnitZ();
 
