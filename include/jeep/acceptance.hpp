@@ -40,6 +40,9 @@
 //     27 with one, where overlap >= 0.6 accepted 21 and 22. Its cost: a pair that overlaps in a
 //     thin wedge (VLP-16s 90 deg apart) or clouds decimated 4x score 0.16-0.22 at the truth and
 //     are refused.
+//   - A refusal for the directional overlap alone can get a second look (second_look.hpp,
+//     opt-in: JeepOptions::second_look), which accepts the sparse pairs' right answers at a
+//     small risk of accepting two unrelated streets.
 //   - min_condition is the registration's own degeneracy threshold: an alignment resting on
 //     the ground alone is not a calibration. bench_jeep --separation measures both
 //     distributions on the paper's pairs (DESIGN.md: measure, do not guess).
