@@ -9,7 +9,8 @@
 //           [--layers N] [--trajectory PREFIX] [--hots NAME=VALUE ...]
 //   --layers N: HOTS's hierarchy layers (default: HierarchyOptions' 3, the paper's).
 //   --trajectory PREFIX: per run, PREFIX_<scenario>_run<k>.csv with the base's true, odometry and
-//   HOTS positions and each one's frame-to-frame motion error (to see where a drift comes from).
+//   HOTS positions, each one's frame-to-frame motion error and orientation error (to see where a
+//   drift comes from).
 //   --hots NAME=VALUE (repeatable): one of HOTS's numeric options by name, for experiments
 //   without a rebuild: plane_voxel, plane_depth, plane_ratio, plane_distance, frame_voxel,
 //   submap_voxel, boundary_registration (0/1), boundary_radius_m, boundary_sigma_m,
@@ -200,7 +201,9 @@ std::string rpe_line(const ulc::sim::Dataset& d, const std::vector<Isometry3d>& 
 }
 
 /// Per frame of the base: time, the truth's, the odometry's and HOTS's positions (in the base's
-/// frame at its first timestamp) and each one's frame-to-frame motion error (m), as CSV.
+/// frame at its first timestamp), each one's frame-to-frame motion error (m) and each one's
+/// orientation error (deg, log(R_true^T R_est) in the true LiDAR frame: x roll, y pitch, z yaw
+/// for a forward-looking base), as CSV.
 void write_trajectory(const std::string& path, const ulc::sim::Dataset& d,
                       const std::vector<Isometry3d>& odometry,
                       const std::vector<Isometry3d>& refined) {
@@ -208,7 +211,8 @@ void write_trajectory(const std::string& path, const ulc::sim::Dataset& d,
   const auto& t = d.lidars[0].timestamps;
   const Isometry3d origin = jeep_test::lidar_pose(d, 0, t.front()).inverse();
   out << "t,truth_x,truth_y,truth_z,odo_x,odo_y,odo_z,hots_x,hots_y,hots_z,odo_step_err,"
-         "hots_step_err\n";
+         "hots_step_err,odo_rot_x_deg,odo_rot_y_deg,odo_rot_z_deg,hots_rot_x_deg,hots_rot_y_deg,"
+         "hots_rot_z_deg\n";
   for (std::size_t k = 0; k < t.size(); ++k) {
     const Isometry3d g = origin * jeep_test::lidar_pose(d, 0, t[k]);
     auto step_error = [&](const std::vector<Isometry3d>& e) {
@@ -220,8 +224,13 @@ void write_trajectory(const std::string& path, const ulc::sim::Dataset& d,
         << g.translation().z() << "," << odometry[k].translation().x() << ","
         << odometry[k].translation().y() << "," << odometry[k].translation().z() << ","
         << refined[k].translation().x() << "," << refined[k].translation().y() << ","
-        << refined[k].translation().z() << "," << step_error(odometry) << "," << step_error(refined)
-        << "\n";
+        << refined[k].translation().z() << "," << step_error(odometry) << ","
+        << step_error(refined);
+    for (const auto* e : {&odometry, &refined}) {
+      const ulc::Vec3d w = ulc::so3_log(Eigen::Matrix3d(g.linear().transpose() * (*e)[k].linear()));
+      out << "," << w.x() / kDeg << "," << w.y() / kDeg << "," << w.z() / kDeg;
+    }
+    out << "\n";
   }
   std::cerr << "bench_hots: wrote " << path << "\n";
 }
