@@ -6,7 +6,8 @@
 //                            [--spread-png PREFIX]
 //   common: [--decimation 1] [--threads 2] [--deskew-from-base] [--jeep-decides]
 //           [--first-run 0] [--json]
-//           [--layers N] [--trajectory PREFIX] [--hots NAME=VALUE ...]
+//           [--layers N] [--trajectory PREFIX] [--hots NAME=VALUE ...] [--steering-ramp M]
+//           [--no-traffic]
 //   --layers N: HOTS's hierarchy layers (default: HierarchyOptions' 3, the paper's).
 //   --trajectory PREFIX: per run, PREFIX_<scenario>_run<k>.csv with the base's true, odometry and
 //   HOTS positions, each one's frame-to-frame motion error and orientation error (to see where a
@@ -16,6 +17,9 @@
 //   submap_voxel, boundary_registration (0/1), boundary_radius_m, boundary_sigma_m,
 //   boundary_sigma_rad, extrinsic_sigma_m, extrinsic_sigma_rad, link_min_layer, rounds, window,
 //   synchronise_time (0/1).
+//   --steering-ramp M: the simulated vehicle follows its route averaged over M metres, so that
+//   yaw rate and body roll ramp into turns (ulc::sim::MotionSpec::steering_ramp_m; default 0:
+//   they step where a line meets an arc). --no-traffic: no oncoming cars.
 //   --jeep-decides: a failed JEEP ends the run (by default, as in the pipeline, a JEEP that was
 //   rejected or did not settle hands its extrinsic to HOTS, whose cross links judge it:
 //   CalibrateOptions::hots_judges_jeep; the stderr line says "judged").
@@ -85,6 +89,7 @@ struct Config {
   bool hots_judges_jeep = true;   ///< off with --jeep-decides
   double pre_shift_s = 0.0;       ///< --pre-shift-ms
   bool no_traffic = false;        ///< --no-traffic: the scenario without its oncoming cars
+  double steering_ramp_m = 0.0;   ///< --steering-ramp M: MotionSpec::steering_ramp_m
   int layers = 0;                 ///< --layers: HOTS hierarchy layers; 0: the default
   std::string trajectory;         ///< --trajectory PREFIX: per-frame poses of each run, as CSV
   std::vector<std::string> hots_settings;  ///< --hots NAME=VALUE, applied in order
@@ -257,6 +262,7 @@ Run one_run(const std::string& scenario, double offset_s, std::size_t run, const
   auto spec = *ulc::sim::scenario(scenario);
   if (offset_s != 0.0) ulc::sim::set_clock_offset(spec, spec.pairs.at(0).target, offset_s);
   if (c.no_traffic) spec.traffic_per_km = 0.0;
+  spec.motion.steering_ramp_m = c.steering_ramp_m;
   ulc::sim::SimulationOptions so;
   so.seconds = c.seconds;
   so.seed = run + 1;
@@ -504,6 +510,7 @@ int main(int argc, char** argv) {
       .value("--layers", ulc_bench::at_least(c.layers, 1))
       .value("--trajectory", ulc_bench::text(c.trajectory))
       .value("--hots", ulc_bench::append(c.hots_settings))
+      .value("--steering-ramp", ulc_bench::number(c.steering_ramp_m))
       .flag("--no-traffic", [&] { c.no_traffic = true; })
       .flag("--deskew-from-base", [&] { c.deskew_from_base = true; })
       .flag("--jeep-decides", [&] { c.hots_judges_jeep = false; });

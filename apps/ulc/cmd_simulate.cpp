@@ -80,6 +80,9 @@ int run_simulate(int argc, char** argv) {
       .option("seed", "N", "seed of scene, route, phases and noise (default 1)")
       .option("rate", "HZ", "frame rate of every LiDAR (default: the scenario's)")
       .option("time-offset", "S", "clock offset of every target: t_base_clock = t_target_clock + S")
+      .option("steering-ramp", "M",
+              "the vehicle follows its route averaged over M metres, so that yaw rate and body "
+              "roll ramp into turns (default 0: they step where a street meets a corner arc)")
       .option("preview", "PNG", "also draw every LiDAR's first frame, top-down and side")
       .flag("list", "list the scenarios and exit")
       .flag("quiet", "no progress on stderr")
@@ -98,10 +101,16 @@ int run_simulate(int argc, char** argv) {
   if (!args.has("scenario"))
     throw cli::UsageError("simulate: missing required option '--scenario NAME' (see --list)");
   if (!args.has("out")) throw cli::UsageError("simulate: missing required option '--out DIR'");
-  const auto spec = sim::scenario(args.get("scenario"));
+  auto spec = sim::scenario(args.get("scenario"));
   if (!spec)
     throw cli::UsageError("simulate: unknown scenario '" + args.get("scenario") +
                           "' (see `ulc simulate --list`)");
+  if (args.has("steering-ramp")) {
+    const double ramp = args.get_double("steering-ramp", 0.0);
+    if (!(ramp >= 0.0 && ramp <= 50.0))
+      throw cli::UsageError("simulate: option '--steering-ramp' must be in [0, 50] m");
+    spec->motion.steering_ramp_m = ramp;
+  }
   sim::SimulationOptions options;
   options.seconds = args.get_double("seconds", 20.0);
   if (!(options.seconds > 0 && options.seconds <= 3600))

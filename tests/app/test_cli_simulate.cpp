@@ -98,4 +98,14 @@ TEST_CASE("ulc simulate lists scenarios and rejects bad values with exit code 2"
   usage("--scenario 64-32 --out /tmp/x --seconds abc", "expects a number");
   usage("--scenario 64-32 --out /tmp/x --seed -4", "--seed");
   usage("--scenario 64-32 --out /tmp/x --rate 0", "--rate");
+  usage("--scenario 64-32 --out /tmp/x --steering-ramp -2", "--steering-ramp");
+
+  const fs::path ramped = fs::temp_directory_path() / "ulc_test_simulate_ramp";
+  fs::remove_all(ramped);
+  const auto run = run_command(kUlc + " simulate --scenario 32-16 --seconds 0.1 --quiet " +
+                               "--steering-ramp 6 --out " + quote(ramped.string()));
+  INFO(run.output);
+  CHECK(run.exit_code == 0);
+  CHECK(fs::exists(ramped / "ground_truth.json"));
+  fs::remove_all(ramped);
 }

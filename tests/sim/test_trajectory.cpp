@@ -159,3 +159,94 @@ TEST_CASE("tunnel: straight through along +x; highway: straight-ish", "[sim][tra
   CHECK(max_heading < 15.0 * M_PI / 180);
   CHECK(max_heading > 0.5 * M_PI / 180);  // it does bend a little
 }
+
+namespace {
+
+/// A line, a 90 deg left arc of radius 12 m, and a line: one line-arc junction at s = 60 m.
+Path2d corner_route() {
+  Path2d path(Eigen::Vector2d(0.0, 0.0), 0.0);
+  path.add_line(60.0);
+  path.add_arc(12.0, M_PI / 2);
+  path.add_line(300.0);
+  return path;
+}
+
+}  // namespace
+
+TEST_CASE("path position integral matches numerical integration", "[sim][trajectory]") {
+  const Path2d path = corner_route();
+  for (double s : {-3.0, 0.0, 10.0, 59.0, 65.0, 78.0, 300.0, path.length() + 20.0}) {
+    // Midpoint rule from -5 m to s (the path extended straight back before 0), with the
+    // integral's own value at -5 m as the start.
+    const int n = 200000;
+    const double a = -5.0, h = (s - a) / n;
+    Eigen::Vector2d sum = path.position_integral(a);
+    for (int i = 0; i < n; ++i) sum += h * path.extended_at(a + (i + 0.5) * h).position;
+    INFO("s = " << s);
+    CHECK((path.position_integral(s) - sum).norm() < 1e-4);
+  }
+}
+
+TEST_CASE("averaged path: unchanged on lines, inside arcs, curvature ramps over the window",
+          "[sim][trajectory]") {
+  const Path2d path = corner_route();
+  const double L = 6.0, R = 12.0;
+  // Far from the junctions it is the path itself on a line ...
+  const PathPoint on_line = path.averaged(30.0, L);
+  CHECK((on_line.position - path.at(30.0).position).norm() < 1e-9);
+  CHECK(on_line.heading == Approx(0.0).margin(1e-12));
+  CHECK(on_line.curvature == Approx(0.0).margin(1e-12));
+  // ... and L^2 / (24 R) inside it in the middle of the arc, with the arc's heading and curvature.
+  const double mid = 60.0 + R * M_PI / 4;
+  const PathPoint on_arc = path.averaged(mid, L), exact = path.at(mid);
+  const Eigen::Vector2d centre(60.0, R);
+  const double inside = R - (on_arc.position - centre).norm();
+  CHECK(inside == Approx(L * L / (24 * R)).epsilon(0.01));
+  CHECK(on_arc.heading == Approx(exact.heading).margin(1e-9));
+  CHECK(on_arc.curvature == Approx(1.0 / R).epsilon(1e-9));
+  // Across the junction the curvature ramps from 0 to 1/R over [60 - L/2, 60 + L/2]: no step,
+  // and it is the heading's rate (central differences).
+  double max_step = 0.0;
+  for (double s = 50.0; s < 70.0; s += 0.01) {
+    const double k0 = path.averaged(s, L).curvature, k1 = path.averaged(s + 0.01, L).curvature;
+    max_step = std::max(max_step, std::abs(k1 - k0));
+    const double rate =
+        (path.averaged(s + 1e-4, L).heading - path.averaged(s - 1e-4, L).heading) / 2e-4;
+    INFO("s = " << s);
+    CHECK(rate == Approx(k0).margin(1e-5));
+  }
+  CHECK(max_step < 1.5 * 0.01 / (L * R));  // a ramp of slope 1 / (L R)
+  CHECK(path.averaged(60.0 - L / 2 - 0.01, L).curvature == Approx(0.0).margin(1e-9));
+  CHECK(path.averaged(60.0 + L / 2 + 0.01, L).curvature == Approx(1.0 / R).epsilon(1e-6));
+  // Without a window the curvature steps at the junction.
+  CHECK(path.averaged(60.0 + 1e-6, 0.0).curvature - path.averaged(60.0 - 1e-6, 0.0).curvature ==
+        Approx(1.0 / R));
+}
+
+TEST_CASE("steering ramp: yaw rate and body roll ramp in instead of stepping into a turn",
+          "[sim][trajectory]") {
+  MotionSpec motion;
+  motion.bumps = false;
+  auto largest_change_per_ms = [&](double ramp) {
+    motion.steering_ramp_m = ramp;
+    const VehicleTrajectory traj(corner_route(), GroundRelief(), motion, 7, 40.0);
+    double roll_step = 0.0, yaw_rate_step = 0.0, prev_rate = 0.0;
+    ulc::Vec3d prev = ulc::rpy_from_rotation(traj.pose(0.0).linear());
+    for (double t = 1e-3; t < 40.0; t += 1e-3) {
+      const ulc::Vec3d rpy = ulc::rpy_from_rotation(traj.pose(t).linear());
+      const double rate = std::remainder(rpy.z() - prev.z(), 2 * M_PI) / 1e-3;
+      roll_step = std::max(roll_step, std::abs(rpy.x() - prev.x()));
+      if (t > 2e-3) yaw_rate_step = std::max(yaw_rate_step, std::abs(rate - prev_rate));
+      prev = rpy;
+      prev_rate = rate;
+    }
+    return std::make_pair(roll_step, yaw_rate_step);
+  };
+  const auto [roll_step, yaw_rate_step] = largest_change_per_ms(0.0);
+  const auto [ramped_roll_step, ramped_yaw_rate_step] = largest_change_per_ms(6.0);
+  // Turn speed sqrt(2 / (1/12)) ~ 4.9 m/s: a 0.016 rad roll and a 0.4 rad/s yaw-rate step.
+  CHECK(roll_step > 0.01);
+  CHECK(yaw_rate_step > 0.3);
+  CHECK(ramped_roll_step < 1e-4);
+  CHECK(ramped_yaw_rate_step < 1e-2);
+}

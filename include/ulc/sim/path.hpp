@@ -7,6 +7,11 @@
 //     it clamps, beyond length() it continues straight along the final heading.
 //   - Corners are filleted: add a corner point and a radius, and the path turns on the arc
 //     tangent to both legs (fillet_polyline).
+//   - averaged(s, L) is the path's moving average over [s - L/2, s + L/2] (exact, from the
+//     closed-form integral of the position; before 0 the path is extended straight back): its
+//     heading is that of the chord between the ends of that stretch, so its curvature ramps in
+//     over L where a line meets an arc instead of stepping (a clothoid-like transition), and on
+//     an arc of radius R it runs about L^2 / (24 R) inside the arc.
 #pragma once
 
 #include <Eigen/Core>
@@ -56,6 +61,57 @@ class Path2d {
     return out;
   }
 
+  /// Integral of the position from 0 to s (m^2); before 0 the path is taken straight back
+  /// along its start heading (as in averaged(), unlike at(), which clamps there).
+  Eigen::Vector2d position_integral(double s) const {
+    const PathPoint p0 = at(0.0);
+    if (segments_.empty()) return s * p0.position;
+    if (s <= 0.0)
+      return s * p0.position +
+             0.5 * s * s * Eigen::Vector2d(std::cos(p0.heading), std::sin(p0.heading));
+    if (s >= length()) {
+      const double u = s - length();
+      const Segment& last = segments_.back();
+      const Eigen::Vector2d d(std::cos(end_.heading), std::sin(end_.heading));
+      return last.integral0 + last.integral(last.length) + u * end_.position + 0.5 * u * u * d;
+    }
+    auto it = std::upper_bound(segments_.begin(), segments_.end(), s,
+                               [](double v, const Segment& seg) { return v < seg.s0; });
+    const Segment& seg = *(it - 1);
+    return seg.integral0 + seg.integral(s - seg.s0);
+  }
+
+  /// The moving average of the path over `window` metres centred on s (see the conventions):
+  /// position, the chord's heading (unwrapped next to at(s).heading) and its rate of change per
+  /// metre of s, as curvature.
+  PathPoint averaged(double s, double window) const {
+    const PathPoint here = at(s);
+    if (!(window > 0.0)) return here;
+    const PathPoint a = extended_at(s - 0.5 * window), b = extended_at(s + 0.5 * window);
+    const Eigen::Vector2d chord = b.position - a.position;
+    PathPoint out;
+    out.position =
+        (position_integral(s + 0.5 * window) - position_integral(s - 0.5 * window)) / window;
+    const double n2 = chord.squaredNorm();
+    if (!(n2 > 1e-18)) return here;
+    out.heading = here.heading + std::remainder(std::atan2(chord.y(), chord.x()) - here.heading,
+                                                6.283185307179586);
+    // d chord / ds = tangent(s + L/2) - tangent(s - L/2).
+    const Eigen::Vector2d dchord = Eigen::Vector2d(std::cos(b.heading), std::sin(b.heading)) -
+                                   Eigen::Vector2d(std::cos(a.heading), std::sin(a.heading));
+    out.curvature = (chord.x() * dchord.y() - chord.y() * dchord.x()) / n2;
+    return out;
+  }
+
+  /// at(s), but before 0 straight back along the start heading instead of clamped.
+  PathPoint extended_at(double s) const {
+    if (s >= 0.0 || segments_.empty()) return at(s);
+    PathPoint p = at(0.0);
+    p.position += s * Eigen::Vector2d(std::cos(p.heading), std::sin(p.heading));
+    p.curvature = 0.0;
+    return p;
+  }
+
   PathPoint at(double s) const {
     if (segments_.empty()) return end_;
     s = std::max(s, 0.0);
@@ -78,7 +134,18 @@ class Path2d {
     double length;
     double curvature;
     PathPoint start;
+    Eigen::Vector2d integral0 = Eigen::Vector2d::Zero();  ///< position integral from 0 to s0
     double s1() const { return s0 + length; }
+    /// Integral of the position over the first u metres of this segment.
+    Eigen::Vector2d integral(double u) const {
+      const double h0 = start.heading;
+      const double c0 = std::cos(h0), s0h = std::sin(h0);
+      if (curvature == 0.0) return u * start.position + 0.5 * u * u * Eigen::Vector2d(c0, s0h);
+      const double k = curvature, h = h0 + k * u;
+      return u * start.position +
+             Eigen::Vector2d((c0 - std::cos(h)) / k - u * s0h, u * c0 - (std::sin(h) - s0h) / k) /
+                 k;
+    }
     PathPoint eval(double u) const {
       PathPoint p;
       p.curvature = curvature;
@@ -101,6 +168,10 @@ class Path2d {
     if (!(length > 0.0)) return;
     Segment seg{this->length(), length, curvature, end_};
     seg.start.curvature = curvature;
+    seg.integral0 = segments_.empty()
+                        ? Eigen::Vector2d::Zero().eval()
+                        : Eigen::Vector2d(segments_.back().integral0 +
+                                          segments_.back().integral(segments_.back().length));
     segments_.push_back(seg);
     end_ = seg.eval(length);
     end_.curvature = 0.0;

@@ -6,9 +6,10 @@
 //     pose(t) is T_world_vehicle at time t (seconds of true time, which is the clock of every
 //     LiDAR whose clock offset is zero; see scenario.hpp).
 //   - Orientation is R = Rz(yaw) Ry(pitch) Rx(roll) (ulc::rotation_from_rpy): yaw is the route
-//     heading; pitch = -atan(ground slope ahead) - pitch_per_accel * a (the nose dips when
-//     braking) + bump and vibration terms; roll = atan(ground slope to the left) +
-//     roll_per_lateral_accel * v^2 kappa (the body leans out of turns) + vibration.
+//     heading (of the route averaged over steering_ramp_m when that is > 0, with its kappa); pitch
+//     = -atan(ground slope ahead) - pitch_per_accel * a (the nose dips when braking) + bump and
+//     vibration terms; roll = atan(ground slope to the left) + roll_per_lateral_accel * v^2 kappa
+//     (the body leans out of turns) + vibration.
 //   - The speed is simulated once at kControlDt with acceleration limits and a look-ahead
 //     braking profile for turns and random slow-downs, then stored at kTableDt; s(t) is the
 //     cubic Hermite through (s, v) samples, so position and velocity are continuous and
@@ -43,6 +44,12 @@ struct MotionSpec {
   double roll_per_lateral_accel = 0.008;  ///< rad per m/s^2
   double lift_amplitude = 0.0;            ///< m; > 0 adds a vertical platform motion (bucket truck)
   double lift_period = 30.0;              ///< s, one up-and-down cycle
+  /// m; > 0: the vehicle follows the route's moving average over this length
+  /// (Path2d::averaged), so its yaw rate and body roll ramp in over it where a line meets an
+  /// arc, as on a clothoid, instead of stepping there (0: the route's lines and arcs as they
+  /// are). The speed profile stays that of the route; on the averaged path the vehicle is up
+  /// to a few per cent slower in tight turns (the chord is shorter than the arc).
+  double steering_ramp_m = 0.0;
 };
 
 class VehicleTrajectory {
@@ -115,7 +122,7 @@ class VehicleTrajectory {
     const double s = distance(t);
     const double v = frozen_ ? 0.0 : speed(t);  // parked: no body dynamics
     const double a = frozen_ ? 0.0 : acceleration(t);
-    const PathPoint p = route_.at(s);
+    const PathPoint p = route_.averaged(s, motion_.steering_ramp_m);
     const double ch = std::cos(p.heading), sh = std::sin(p.heading);
     const Eigen::Vector2d grad = ground_.gradient(p.position.x(), p.position.y());
     double z = ground_.height(p.position.x(), p.position.y());
