@@ -17,9 +17,9 @@
 //     the drive; JEEP over --frames pairs from each window's first pair, scan-scan on that
 //     first pair. Success: status ok and e_rot < 1 deg and e_trans < 10 cm; a result reported
 //     ok but outside those is a false accept. Medians are over all runs.
-// separation: the acceptance rule's evidence (overlap, directional overlap, condition) for the true
-// data and for
-//     unrelated data (b's frames from the other half of the drive, relabelled in time).
+// separation: the acceptance rule's evidence (overlap, directional and off-ground overlap,
+//     condition) for the true data and for unrelated data (b's frames from the other half of
+//     the drive, relabelled in time).
 // (b) robustness: success over a 6x6 grid of initial rotation (0..12.5 deg) x translation
 //     (0..5 m) disturbance; --frames-sweep: success and errors for K = 2..12 at 5 deg, 2 m.
 // (c) odometry: multi-LiDAR odometry over the drive with the true extrinsic: relative
@@ -170,6 +170,7 @@ struct Outcome {
   double seconds = 0.0;
   double overlap = 0.0;
   double directional_overlap = 0.0;
+  double off_ground_overlap = 0.0;
   double condition = 0.0;
   bool by_second_look = false;  ///< accepted by the second look (jeep/second_look.hpp)
   int rounds = 0;
@@ -210,6 +211,7 @@ Outcome run_jeep(const Window& w, const Isometry3d& initial, const Isometry3d& t
   out.error = ulc::pose_error(truth, r.extrinsic);
   out.overlap = r.acceptance.overlap;
   out.directional_overlap = r.acceptance.directional_overlap;
+  out.off_ground_overlap = r.acceptance.off_ground_overlap;
   out.condition = r.acceptance.condition;
   out.by_second_look = r.second_look.passed;
   out.rounds = r.rounds;
@@ -229,6 +231,7 @@ Outcome run_scan_scan(const Drive& d, std::size_t pair, const Isometry3d& initia
   out.error = ulc::pose_error(d.truth, r.extrinsic);
   out.overlap = r.acceptance.overlap;
   out.directional_overlap = r.acceptance.directional_overlap;
+  out.off_ground_overlap = r.acceptance.off_ground_overlap;
   out.condition = r.acceptance.condition;
   return out;
 }
@@ -309,14 +312,14 @@ void separation(Config c) {
     c.scenarios = {"64-32", "32-16", "horizon-tele", "64-horizon", "32-avia", "64-tele"};
   if (!c.starts) c.starts = 10;
   ulc_bench::Table table({"scenario", "data", "runs", "settled", "accepted_pct", "by_second_look",
-                          "overlap_median", "overlap_max", "dir_overlap_min", "dir_overlap_median",
-                          "dir_overlap_max", "condition_min"});
+                          "overlap_median", "dir_overlap_min", "dir_overlap_max", "off_ground_min",
+                          "off_ground_median", "off_ground_max", "condition_min"});
   const jeep::JeepOptions o = jeep_options(c, c.frames);
   for (const auto& scenario : c.scenarios) {
     const Drive d = load_drive(scenario, c);
     const std::size_t half = d.pairs.size() / 2;
     for (int unrelated = 0; unrelated < 2; ++unrelated) {
-      std::vector<double> overlap, directional, condition;
+      std::vector<double> overlap, directional, off_ground, condition;
       std::size_t accepted = 0, runs = 0, by_second_look = 0;
       for (std::size_t s : start_pairs(d, c.starts, c.frames)) {
         // Unrelated: b's frames from half a drive away (another street), a's timestamps.
@@ -333,6 +336,7 @@ void separation(Config c) {
         if (!settled || (!unrelated && !ulc::is_calibration_success(r.error))) continue;
         overlap.push_back(r.overlap);
         directional.push_back(r.directional_overlap);
+        off_ground.push_back(r.off_ground_overlap);
         condition.push_back(r.condition);
       }
       auto mn = [](const std::vector<double>& v) {
@@ -346,9 +350,10 @@ void separation(Config c) {
                      Cell::integer(static_cast<long long>(overlap.size())),
                      Cell::num(runs ? 100.0 * accepted / runs : 0.0, 1),
                      Cell::integer(static_cast<long long>(by_second_look)),
-                     Cell::num(jeep_test::median(overlap), 3), Cell::num(mx(overlap), 3),
-                     Cell::num(mn(directional), 3), Cell::num(jeep_test::median(directional), 3),
-                     Cell::num(mx(directional), 3), Cell::num(mn(condition), 4)});
+                     Cell::num(jeep_test::median(overlap), 3), Cell::num(mn(directional), 3),
+                     Cell::num(mx(directional), 3), Cell::num(mn(off_ground), 3),
+                     Cell::num(jeep_test::median(off_ground), 3), Cell::num(mx(off_ground), 3),
+                     Cell::num(mn(condition), 4)});
     }
   }
   emit(
@@ -361,7 +366,10 @@ void separation(Config c) {
         "success bounds; the statistics are over these"},
        {"overlap", "agreeing / near points of the smaller map (acceptance.hpp)"},
        {"dir_overlap", "agreeing share of the near points' information in the weakest direction"},
-       {"rule", "accept iff dir_overlap >= " +
+       {"off_ground", "the same over the directions the dominant plane (the ground) leaves free"},
+       {"rule", "accept iff off_ground >= " +
+                    std::to_string(jeep::AcceptanceOptions{}.min_off_ground_overlap) +
+                    ", dir_overlap >= " +
                     std::to_string(jeep::AcceptanceOptions{}.min_directional_overlap) +
                     " and condition >= " + std::to_string(jeep::AcceptanceOptions{}.min_condition) +
                     (c.second_look ? ", or by the second look (jeep/second_look.hpp)" : "")}});

@@ -168,7 +168,7 @@ int run_calibrate(int argc, char** argv) {
       .flag("no-route",
             "do not calibrate a failed target through another target that did calibrate")
       .flag("second-look",
-            "JEEP: give a refusal for the directional overlap alone a second look (both "
+            "JEEP: give a refusal for the off-ground overlap alone a second look (both "
             "registration directions agree, and starts around the result come back to it); "
             "accepts more sparse pairs (VLP-16, Avia), at a small risk of accepting a wrong fit")
       .flag("no-cycles", "do not check the cycles base -> i -> j -> base (two targets or more)")

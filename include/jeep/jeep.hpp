@@ -19,7 +19,7 @@
 //     pose of a by less than the same. No settling within max_rounds (the paper: "exceeding a
 //     certain number of iterations is a failure"; 10) gives status not_converged.
 //   - Acceptance (status rejected otherwise), see acceptance.hpp; optionally with a second
-//     look at a refusal for the directional overlap alone (second_look.hpp).
+//     look at a refusal for the off-ground overlap alone (second_look.hpp).
 //   - Nothing here throws or prints; the result is the same for any number of threads.
 #pragma once
 
@@ -60,7 +60,7 @@ struct JeepOptions {
   double settle_translation = 0.005;  ///< m
   double settle_rotation = 3.5e-4;    ///< rad (0.02 deg)
   AcceptanceOptions acceptance;
-  /// Opt-in: a refusal for the directional overlap alone gets a second look (second_look.hpp).
+  /// Opt-in: a refusal for the off-ground overlap alone gets a second look (second_look.hpp).
   SecondLookOptions second_look;
   /// Frame period when the timestamps cannot tell (a single frame): DESIGN.md's 10 Hz.
   double default_period = 0.1;

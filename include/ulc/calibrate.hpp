@@ -332,6 +332,7 @@ inline JeepReport jeep_report(const jeep::JeepResult& j, const Isometry3d& initi
   r.accepted = j.acceptance.accepted;
   r.overlap = j.acceptance.overlap;
   r.directional_overlap = j.acceptance.directional_overlap;
+  r.off_ground_overlap = j.acceptance.off_ground_overlap;
   r.two_way = j.two_way.applied;
   r.two_way_gap_translation = j.two_way.gap_translation;
   r.two_way_gap_rotation = j.two_way.gap_rotation;

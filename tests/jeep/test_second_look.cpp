@@ -1,4 +1,4 @@
-// The second look at a refusal for the directional overlap alone (jeep/second_look.hpp): a fit
+// The second look at a refusal for the off-ground overlap alone (jeep/second_look.hpp): a fit
 // that every start of the paper's disturbance comes back to passes; a fit that leaves a
 // direction free, or that the two registration directions disagree on, does not.
 #include <catch2/catch.hpp>
@@ -116,22 +116,27 @@ TEST_CASE("the second look needs both directions to agree", "[jeep][second_look]
   CHECK(std::string(r.reason).find("one failed") != std::string::npos);
 }
 
-TEST_CASE("only a refusal for the directional overlap alone gets a second look",
+TEST_CASE("only a refusal for the off-ground overlap alone gets a second look",
           "[jeep][second_look]") {
   const jeep::AcceptanceOptions rule;
   const jeep::SecondLookOptions options = enabled();
   jeep::AcceptanceReport r;
   r.agreeing = rule.min_agreeing;
   r.condition = rule.min_condition;
-  r.directional_overlap = 0.5 * (options.min_directional_overlap + rule.min_directional_overlap);
+  r.directional_overlap = rule.min_directional_overlap;
+  r.off_ground_overlap = 0.5 * (options.min_off_ground_overlap + rule.min_off_ground_overlap);
   CHECK(jeep::qualifies_for_second_look(r, rule, options));
+
+  jeep::AcceptanceReport ground = r;  // refused for the ground itself: no second look
+  ground.directional_overlap = 0.5 * rule.min_directional_overlap;
+  CHECK_FALSE(jeep::qualifies_for_second_look(ground, rule, options));
 
   jeep::AcceptanceReport accepted = r;
   accepted.accepted = true;
   CHECK_FALSE(jeep::qualifies_for_second_look(accepted, rule, options));
 
   jeep::AcceptanceReport too_low = r;
-  too_low.directional_overlap = 0.5 * options.min_directional_overlap;
+  too_low.off_ground_overlap = 0.5 * options.min_off_ground_overlap;
   CHECK_FALSE(jeep::qualifies_for_second_look(too_low, rule, options));
 
   jeep::AcceptanceReport few = r;

@@ -109,7 +109,8 @@ struct JeepReport {
   double final_rmse = 0.0;           ///< m
   bool accepted = false;             ///< the acceptance rule's verdict
   double overlap = 0.0;              ///< acceptance: agreeing / near map points
-  double directional_overlap = 0.0;  ///< acceptance: the same, weakest direction (judged)
+  double directional_overlap = 0.0;  ///< acceptance: the same, weakest direction (a floor)
+  double off_ground_overlap = 0.0;   ///< acceptance: weakest direction off the ground (judged)
   /// Two-way step (jeep/two_way.hpp): applied, and how far the two directions disagreed.
   bool two_way = false;
   double two_way_gap_translation = 0.0;  ///< m
@@ -118,7 +119,7 @@ struct JeepReport {
   /// scored, and the start whose basin won (0: the initial extrinsic's own).
   std::size_t start_basins = 0;
   std::size_t start_chosen = 0;
-  /// The second look at a refusal for the directional overlap alone (jeep/second_look.hpp):
+  /// The second look at a refusal for the off-ground overlap alone (jeep/second_look.hpp):
   /// whether it ran, and how many of its starts came back to the extrinsic.
   bool second_look = false;
   bool second_look_passed = false;

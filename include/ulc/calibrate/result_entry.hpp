@@ -114,6 +114,7 @@ inline io::Json jeep_to_json(const JeepReport& r) {
   j["accepted"] = r.accepted;
   j["overlap"] = r.overlap;
   j["directional_overlap"] = r.directional_overlap;
+  j["off_ground_overlap"] = r.off_ground_overlap;
   j["two_way"] = r.two_way;
   j["two_way_gap_m"] = r.two_way_gap_translation;
   j["two_way_gap_deg"] = r.two_way_gap_rotation * result_detail::kDegPerRad;
