@@ -19,6 +19,7 @@
 #include "ulc/io/ground_truth.hpp"
 #include "ulc/io/pcd.hpp"
 #include "ulc/io/result_file.hpp"
+#include "ulc_app_path.hpp"
 
 namespace fs = std::filesystem;
 using ulc_test::quote;
@@ -26,7 +27,7 @@ using ulc_test::run_command;
 
 namespace {
 
-const std::string kUlc = ULC_APP_PATH;
+using ulc_test::kUlc;
 constexpr double kDeg = 3.14159265358979323846 / 180.0;
 
 /// A 0.6 s 64-32 drive (six frames per LiDAR) in its own temporary folder, removed afterwards.

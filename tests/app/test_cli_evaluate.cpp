@@ -6,6 +6,7 @@
 #include "ulc/core/lie.hpp"
 #include "ulc/io/ground_truth.hpp"
 #include "ulc/io/result_file.hpp"
+#include "ulc_app_path.hpp"
 
 namespace fs = std::filesystem;
 using ulc_test::quote;
@@ -13,7 +14,7 @@ using ulc_test::run_command;
 
 namespace {
 
-const std::string kUlc = ULC_APP_PATH;
+using ulc_test::kUlc;
 
 struct TempDir {
   fs::path path;

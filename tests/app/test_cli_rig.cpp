@@ -19,6 +19,7 @@
 #include "ulc/io/result_file.hpp"
 #include "ulc/sim/dataset_writer.hpp"
 #include "ulc/sim/simulate.hpp"
+#include "ulc_app_path.hpp"
 
 namespace fs = std::filesystem;
 using ulc_test::quote;
@@ -26,7 +27,7 @@ using ulc_test::run_command;
 
 namespace {
 
-const std::string kUlc = ULC_APP_PATH;
+using ulc_test::kUlc;
 
 /// campus-bs with the left Bpearl first (the base), 0.6 s, every 4th sample, in a temporary
 /// folder removed afterwards.

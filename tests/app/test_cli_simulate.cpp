@@ -8,6 +8,7 @@
 #include "ulc/io/ground_truth.hpp"
 #include "ulc/io/pcd.hpp"
 #include "ulc/io/sequence.hpp"
+#include "ulc_app_path.hpp"
 
 namespace fs = std::filesystem;
 using ulc_test::quote;
@@ -15,7 +16,7 @@ using ulc_test::run_command;
 
 namespace {
 
-const std::string kUlc = ULC_APP_PATH;
+using ulc_test::kUlc;
 
 std::string read_all(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);

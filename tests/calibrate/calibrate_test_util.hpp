@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "test_units.hpp"
 #include "ulc/calibrate.hpp"
 #include "ulc/core/lie.hpp"
 #include "ulc/core/point_cloud.hpp"
@@ -31,7 +32,7 @@ ulc::calibrate_pair<calibrate_test::SimFrames, calibrate_test::SimFrames>(
 
 namespace calibrate_test {
 
-constexpr double kDeg = 3.14159265358979323846 / 180.0;
+using ulc_test::kDeg;
 
 /// A seeded 64-32 town drive, every `decimation`-th point kept.
 inline ulc::sim::Dataset simulate_64_32(double seconds, std::uint64_t seed, unsigned decimation) {

@@ -5,11 +5,12 @@
 #include <Eigen/Geometry>
 #include <cmath>
 
+#include "test_units.hpp"
 #include "ulc/calibrate/terra_hypotheses.hpp"
 
 namespace {
 
-constexpr double kDeg = 3.14159265358979323846 / 180.0;
+using ulc_test::kDeg;
 
 ulc::Mat3d yaw(double deg) {
   return Eigen::AngleAxisd(deg * kDeg, ulc::Vec3d::UnitZ()).toRotationMatrix();

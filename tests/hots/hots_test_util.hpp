@@ -5,6 +5,7 @@
 #include <random>
 #include <vector>
 
+#include "test_units.hpp"
 #include "ulc/core/lie.hpp"
 #include "ulc/core/types.hpp"
 
@@ -14,7 +15,7 @@ using ulc::Isometry3d;
 using ulc::Vec3d;
 using ulc::Vec6d;
 
-constexpr double kDeg = 3.14159265358979323846 / 180.0;
+using ulc_test::kDeg;
 
 /// [rho; phi] with Gaussian entries of the given standard deviations.
 inline Vec6d random_vector6(std::mt19937_64& rng, double sigma_t, double sigma_r) {

@@ -91,7 +91,7 @@ std::string simple_header(const std::string& format, std::size_t n) {
          "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
 }
 
-void expect_error(const Bytes& bytes, std::initializer_list<std::string> parts) {
+void expect_ply_error(const Bytes& bytes, std::initializer_list<std::string> parts) {
   io_test::TempDir dir;
   const auto path = dir / "bad.ply";
   io_test::write_bytes(path, bytes);
@@ -99,8 +99,8 @@ void expect_error(const Bytes& bytes, std::initializer_list<std::string> parts) 
       io_test::require_io_error([&] { ulc::io::read_ply<ulc::PointCloud<float>>(path); }, parts);
   CHECK(e.file() == path.string());
 }
-void expect_error(const std::string& text, std::initializer_list<std::string> parts) {
-  expect_error(io_test::to_bytes(text), parts);
+void expect_ply_error(const std::string& text, std::initializer_list<std::string> parts) {
+  expect_ply_error(io_test::to_bytes(text), parts);
 }
 
 }  // namespace
@@ -138,25 +138,27 @@ TEST_CASE("PLY writer: big endian bytes are really big endian", "[ply]") {
 }
 
 TEST_CASE("PLY: malformed headers", "[ply][malformed]") {
-  expect_error(Bytes{}, {"empty file"});
-  expect_error("PLY\nformat ascii 1.0\n", {"line 1", "not a PLY file"});
-  expect_error("ply\nelement vertex 1\nproperty float x\nend_header\n", {"missing format"});
-  expect_error("ply\nformat binary_middle_endian 1.0\nend_header\n",
-               {"line 2", "unknown PLY format"});
-  expect_error("ply\nformat ascii 2.0\nend_header\n", {"line 2", "unsupported PLY version"});
-  expect_error("ply\nformat ascii 1.0\nproperty float x\nend_header\n",
-               {"line 3", "property before any element"});
-  expect_error("ply\nformat ascii 1.0\nelement vertex 1\nproperty float16 x\nend_header\n",
-               {"line 4", "unknown property type 'float16'"});
-  expect_error("ply\nformat ascii 1.0\nelement vertex 1\nproperty list float int x\nend_header\n",
-               {"line 4", "list count type 'float' is not an integer type"});
-  expect_error("ply\nformat ascii 1.0\nelement vertex x\n", {"line 3", "element line"});
-  expect_error("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n",
-               {"missing end_header"});
-  expect_error("ply\nformat ascii 1.0\nwhatever\nend_header\n", {"line 3", "unknown header line"});
-  expect_error("ply\nformat ascii 1.0\nelement face 1\nproperty int a\nend_header\n1\n",
-               {"line 5", "no vertex element"});
-  expect_error(
+  expect_ply_error(Bytes{}, {"empty file"});
+  expect_ply_error("PLY\nformat ascii 1.0\n", {"line 1", "not a PLY file"});
+  expect_ply_error("ply\nelement vertex 1\nproperty float x\nend_header\n", {"missing format"});
+  expect_ply_error("ply\nformat binary_middle_endian 1.0\nend_header\n",
+                   {"line 2", "unknown PLY format"});
+  expect_ply_error("ply\nformat ascii 2.0\nend_header\n", {"line 2", "unsupported PLY version"});
+  expect_ply_error("ply\nformat ascii 1.0\nproperty float x\nend_header\n",
+                   {"line 3", "property before any element"});
+  expect_ply_error("ply\nformat ascii 1.0\nelement vertex 1\nproperty float16 x\nend_header\n",
+                   {"line 4", "unknown property type 'float16'"});
+  expect_ply_error(
+      "ply\nformat ascii 1.0\nelement vertex 1\nproperty list float int x\nend_header\n",
+      {"line 4", "list count type 'float' is not an integer type"});
+  expect_ply_error("ply\nformat ascii 1.0\nelement vertex x\n", {"line 3", "element line"});
+  expect_ply_error("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n",
+                   {"missing end_header"});
+  expect_ply_error("ply\nformat ascii 1.0\nwhatever\nend_header\n",
+                   {"line 3", "unknown header line"});
+  expect_ply_error("ply\nformat ascii 1.0\nelement face 1\nproperty int a\nend_header\n1\n",
+                   {"line 5", "no vertex element"});
+  expect_ply_error(
       "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float z\nend_header\n",
       {"line 3", "no field named y"});
 }
@@ -164,10 +166,10 @@ TEST_CASE("PLY: malformed headers", "[ply][malformed]") {
 TEST_CASE("PLY: malformed binary data", "[ply][malformed]") {
   ByteBuilder cut;
   cut.text(simple_header("binary_little_endian", 2)).put(1.f).put(2.f).put(3.f).put(4.f);
-  expect_error(cut.bytes, {"truncated vertex data", "claims 2 vertices"});
+  expect_ply_error(cut.bytes, {"truncated vertex data", "claims 2 vertices"});
   ByteBuilder huge;
   huge.text(simple_header("binary_little_endian", 4000000000u)).put(1.f).put(2.f).put(3.f);
-  expect_error(huge.bytes, {"truncated vertex data", "4000000000 vertices"});
+  expect_ply_error(huge.bytes, {"truncated vertex data", "4000000000 vertices"});
   // A list before the vertex element claims more items than the file holds.
   ByteBuilder list;
   list.text(
@@ -175,24 +177,24 @@ TEST_CASE("PLY: malformed binary data", "[ply][malformed]") {
       "element vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n");
   const std::size_t list_at = list.bytes.size();
   list.put(std::uint32_t{1000000}).put(1.f).put(2.f).put(3.f);
-  expect_error(list.bytes, {"byte " + std::to_string(list_at), "truncated list property idx"});
+  expect_ply_error(list.bytes, {"byte " + std::to_string(list_at), "truncated list property idx"});
   // A negative list count.
   ByteBuilder negative;
   negative.text(
       "ply\nformat binary_little_endian 1.0\nelement face 1\nproperty list char int idx\n"
       "element vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n");
   negative.put(std::int8_t{-1}).put(1.f).put(2.f).put(3.f);
-  expect_error(negative.bytes, {"negative count in list property idx"});
+  expect_ply_error(negative.bytes, {"negative count in list property idx"});
 }
 
 TEST_CASE("PLY: malformed ascii data", "[ply][malformed]") {
   const std::string h = simple_header("ascii", 2);  // end_header is line 7
-  expect_error(h + "1 2 3\n4 x 6\n", {"line 9", "'x' is not a number"});
-  expect_error(h + "1.00 2.00 3.00\n4 5\n", {"line 9", "too few values"});
-  expect_error(h + "1 2 3 4\n4 5 6\n", {"line 8", "expected 3 values", "found 4"});
-  expect_error(h + "1.00 2.00 3.00\n", {"truncated ascii data", "needs 2 records"});
-  expect_error(simple_header("ascii", 1000000) + "1 2 3\n", {"truncated ascii data"});
-  expect_error(
+  expect_ply_error(h + "1 2 3\n4 x 6\n", {"line 9", "'x' is not a number"});
+  expect_ply_error(h + "1.00 2.00 3.00\n4 5\n", {"line 9", "too few values"});
+  expect_ply_error(h + "1 2 3 4\n4 5 6\n", {"line 8", "expected 3 values", "found 4"});
+  expect_ply_error(h + "1.00 2.00 3.00\n", {"truncated ascii data", "needs 2 records"});
+  expect_ply_error(simple_header("ascii", 1000000) + "1 2 3\n", {"truncated ascii data"});
+  expect_ply_error(
       "ply\nformat ascii 1.0\nelement face 1\nproperty list uchar int idx\nelement vertex 1\n"
       "property float x\nproperty float y\nproperty float z\nend_header\n5 1 2\n1 2 3\n",
       {"line 10", "claims 5 items"});

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "test_units.hpp"
 #include "ulc/core/lie.hpp"
 #include "ulc/core/point_cloud.hpp"
 #include "ulc/core/types.hpp"
@@ -23,7 +24,7 @@ using ulc::Isometry3d;
 using ulc::Vec3d;
 using ulc::Vec6d;
 
-constexpr double kDeg = 3.14159265358979323846 / 180.0;
+using ulc_test::kDeg;
 
 struct DriveSpec {
   std::string scenario = "64-32";

@@ -10,6 +10,10 @@ namespace jeep_test {
 
 using SurfacePoints = std::vector<ulc::Vec3<double>>;
 
+/// The axes the rectangles are laid along.
+inline const ulc::Vec3d kX = ulc::Vec3d::UnitX(), kY = ulc::Vec3d::UnitY(),
+                        kZ = ulc::Vec3d::UnitZ();
+
 /// Samples the rectangle origin + u * [0, lu] + v * [0, lv] every `step`, starting at `phase`
 /// (two maps of one surface get different points), with 1 cm of noise along its normal.
 inline void add_rectangle(SurfacePoints& out, const ulc::Vec3d& origin, const ulc::Vec3d& u,

@@ -19,7 +19,9 @@ namespace {
 using jeep_test::add_rectangle;
 using Points = jeep_test::SurfacePoints;
 
-const ulc::Vec3d kX = ulc::Vec3d::UnitX(), kY = ulc::Vec3d::UnitY(), kZ = ulc::Vec3d::UnitZ();
+using jeep_test::kX;
+using jeep_test::kY;
+using jeep_test::kZ;
 
 /// Height of the ground tile (i, j), i, j in 0..9 (4 m tiles).
 using TileHeight = std::function<double(int, int)>;

@@ -14,7 +14,7 @@ using namespace jeep_test;
 namespace {
 
 /// One second of the 64-32 rig driving through town, columns decimated by 4.
-const ulc::sim::Dataset& drive() {
+const ulc::sim::Dataset& odometry_drive() {
   static const ulc::sim::Dataset d = [] {
     DriveSpec spec;
     spec.scenario = "64-32";
@@ -50,7 +50,7 @@ std::vector<Isometry3d> truth_of(const ulc::sim::Dataset& d, std::size_t lidar,
 }  // namespace
 
 TEST_CASE("single-LiDAR odometry follows the simulated drive", "[jeep][odometry]") {
-  const auto& d = drive();
+  const auto& d = odometry_drive();
   const auto& a = d.lidars[0];
   REQUIRE(a.frames.size() >= 8);
   const auto r = jeep::run_single_odometry(a.frames, a.timestamps);
@@ -68,7 +68,7 @@ TEST_CASE("single-LiDAR odometry follows the simulated drive", "[jeep][odometry]
 
 TEST_CASE("multi-LiDAR odometry gives both LiDARs' poses in their own map frames",
           "[jeep][odometry]") {
-  const auto& d = drive();
+  const auto& d = odometry_drive();
   const auto& a = d.lidars[0];
   const auto& b = d.lidars[1];
   const Isometry3d C = d.pairs[0].T_base_target;
@@ -98,7 +98,7 @@ TEST_CASE("multi-LiDAR odometry gives both LiDARs' poses in their own map frames
 }
 
 TEST_CASE("odometry poses unpaired frames by extrapolating the nearest pair", "[jeep][odometry]") {
-  const auto& d = drive();
+  const auto& d = odometry_drive();
   const auto& a = d.lidars[0];
   const auto& b = d.lidars[1];
   // b loses frames 3 and 4: a's frames 3 and 4 have no partner.
@@ -128,7 +128,7 @@ TEST_CASE("odometry poses unpaired frames by extrapolating the nearest pair", "[
 TEST_CASE("odometry recovers from a prediction 40 cm off along the road", "[jeep][odometry]") {
   // A braking or accelerating vehicle leaves the constant-velocity prediction decimetres off;
   // the default steps (coarse, then fine) must pull it back, or the odometry runs away.
-  const auto& a = drive().lidars[0];
+  const auto& a = odometry_drive().lidars[0];
   REQUIRE(a.frames.size() >= 6);
   const jeep::OdometryOptions options;
   const double period = a.timestamps[1] - a.timestamps[0];
@@ -157,7 +157,7 @@ TEST_CASE("odometry recovers from a prediction 40 cm off along the road", "[jeep
 }
 
 TEST_CASE("odometry gives the same bits on 1 and 2 threads", "[jeep][odometry][threads]") {
-  const auto& d = drive();
+  const auto& d = odometry_drive();
   const auto& a = d.lidars[0];
   const auto& b = d.lidars[1];
   const Isometry3d C = d.pairs[0].T_base_target;
@@ -173,7 +173,7 @@ TEST_CASE("odometry gives the same bits on 1 and 2 threads", "[jeep][odometry][t
 }
 
 TEST_CASE("odometry refuses unusable input", "[jeep][odometry]") {
-  const auto& a = drive().lidars[0];
+  const auto& a = odometry_drive().lidars[0];
   std::vector<double> bad = a.timestamps;
   bad[2] = bad[1] - 1.0;
   CHECK(jeep::run_single_odometry(a.frames, bad).status == jeep::OdometryStatus::invalid_input);

@@ -16,7 +16,9 @@ using jeep_test::add_rectangle;
 using Points = jeep_test::SurfacePoints;
 using ulc::Isometry3d;
 
-const ulc::Vec3d kX = ulc::Vec3d::UnitX(), kY = ulc::Vec3d::UnitY(), kZ = ulc::Vec3d::UnitZ();
+using jeep_test::kX;
+using jeep_test::kY;
+using jeep_test::kZ;
 
 /// 40 x 40 m of ground and a 4 m wall facing x at x = 10; with `closed`, also walls facing y at
 /// y = 8 and y = -12 and a 2 m box, so that every direction is pinned.

@@ -8,6 +8,7 @@
 #include <random>
 #include <vector>
 
+#include "test_units.hpp"
 #include "ulc/core/lie.hpp"
 #include "ulc/core/point_cloud.hpp"
 #include "ulc/core/types.hpp"
@@ -20,7 +21,7 @@ using ulc::Mat3d;
 using ulc::Vec3d;
 using ulc::Vec6d;
 
-constexpr double kDeg = 3.14159265358979323846 / 180.0;
+using ulc_test::kDeg;
 
 /// Points sampled uniformly on a rectangle: origin + a*u + b*v, a in [0, lu], b in [0, lv].
 inline void sample_rectangle(std::vector<Vec3d>& out, std::mt19937_64& rng, const Vec3d& origin,

@@ -11,13 +11,14 @@
 #include <random>
 #include <vector>
 
+#include "test_units.hpp"
 #include "ulc/core/lie.hpp"
 #include "ulc/core/types.hpp"
 
 namespace terra_test {
 
 constexpr double kPi = 3.14159265358979323846;
-constexpr double kDeg = kPi / 180.0;
+using ulc_test::kDeg;
 
 inline std::vector<ulc::Vec3d> random_directions(std::size_t n, std::uint64_t seed) {
   std::mt19937_64 rng(seed);
