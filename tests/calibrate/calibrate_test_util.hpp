@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "test_units.hpp"
+#include "../support/test_units.hpp"
 #include "ulc/calibrate.hpp"
 #include "ulc/core/lie.hpp"
 #include "ulc/core/point_cloud.hpp"

@@ -5,7 +5,7 @@
 #include <Eigen/Geometry>
 #include <cmath>
 
-#include "test_units.hpp"
+#include "../support/test_units.hpp"
 #include "ulc/calibrate/terra_hypotheses.hpp"
 
 namespace {

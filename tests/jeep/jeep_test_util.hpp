@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "test_units.hpp"
+#include "../support/test_units.hpp"
 #include "ulc/core/lie.hpp"
 #include "ulc/core/point_cloud.hpp"
 #include "ulc/core/types.hpp"

@@ -8,7 +8,7 @@
 #include <random>
 #include <vector>
 
-#include "test_units.hpp"
+#include "../support/test_units.hpp"
 #include "ulc/core/lie.hpp"
 #include "ulc/core/point_cloud.hpp"
 #include "ulc/core/types.hpp"
