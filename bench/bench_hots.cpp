@@ -119,6 +119,9 @@ void apply_hots_setting(hots::RefineOptions& o, const std::string& setting) {
       {"link_min_layer", [&] { o.links.min_layer = as_int(); }},
       {"rounds", [&] { o.hierarchy.ba.rounds = as_int(); }},
       {"window", [&] { o.hierarchy.window = static_cast<std::size_t>(v); }},
+      {"sweep_parts", [&] { o.hierarchy.sweep_parts = static_cast<int>(v); }},
+      {"end_knot", [&] { o.hierarchy.end_knot = v != 0.0; }},
+      {"end_knot_factor", [&] { o.hierarchy.end_knot_factor = v != 0.0; }},
       {"synchronise_time", [&] { o.synchronise_time = v != 0.0; }},
   };
   for (const auto& [key, set] : setters)
@@ -320,6 +323,13 @@ Run one_run(const std::string& scenario, double offset_s, std::size_t run, const
     out.links = "cross " + std::to_string(st.cross_links) + "/" +
                 std::to_string(st.cross_links_attempted) + ", boundaries " +
                 std::to_string(st.boundary_links) + "/" + std::to_string(st.boundary_factors);
+    // Where HOTS's time goes (RefineStatistics' phase clocks).
+    std::ostringstream phases;
+    phases << "; phases s: prepare " << st.prepare_seconds << ", hierarchy " << st.hierarchy_seconds
+           << ", links " << st.links_seconds << ", graph " << st.graph_seconds << ", sync "
+           << st.sync_seconds << ", sequence " << st.sequence_seconds << "; windows " << st.windows
+           << " (" << st.failed_windows << " failed), planes " << st.planes;
+    out.links += phases.str();
     if (!h.ok()) return;
     out.hots_error = ulc::pose_error(truth, h.extrinsic);
     out.dt_error_s = h.time_offset_s - true_offset;

@@ -18,6 +18,11 @@
 //     the k-th 6x6 block of (H / (2 sigma^2))^-1 (H the BA Hessian without the gauge block,
 //     sigma^2 its noise estimate), i.e. the marginal information of that relative pose.
 //   - Submap clouds are voxel-downsampled (submap_voxel) to bound the upper layers' work.
+//   - Continuous-time layer 0 (optional: the caller passes each frame's SweepParts): the
+//     window's BA is sweep_ba.hpp's, whose variables are the members' poses plus, with
+//     end_knot and a next frame, that frame's pose (where the last sweep ends); the submap
+//     places each part at its own pose. The next frame's estimate is dropped, or kept as one
+//     more factor from the window's anchor (end_knot_factor).
 //   - Nothing here throws or prints; the same results for any number of threads.
 #pragma once
 
@@ -30,6 +35,7 @@
 #include <tbb/parallel_for.h>
 
 #include "hots/pose_graph.hpp"
+#include "hots/sweep_ba.hpp"
 #include "hots/window_ba.hpp"
 #include "ulc/core/point_cloud.hpp"
 #include "ulc/core/voxel_downsample.hpp"
@@ -54,6 +60,25 @@ struct HierarchyOptions {
   }
   /// Floor of the BA noise estimate (m): a near-perfect window does not dominate the graph.
   double min_sigma = 1e-3;
+  /// Layer 0 with continuous-time sweeps (sweep_ba.hpp) when the caller gives the frames'
+  /// parts: each window's last sweep ends at the next frame's pose (a variable of the window,
+  /// not returned) when end_knot, else it stays as deskewed.
+  bool end_knot = true;
+  /// With end_knot: the window's estimate of the next frame's pose also becomes a factor (from
+  /// the window's anchor to that frame, its marginal information): the windows of layer 0 tie
+  /// to each other directly.
+  bool end_knot_factor = false;
+  /// Parts per sweep for the continuous-time layer 0 (refine() splits the frames); 1: rigid.
+  int sweep_parts = 1;
+};
+
+/// One frame's sweep for a continuous-time layer 0: its points in parts by time, each part's
+/// mean fraction of the frame period, and the motion the points were deskewed with.
+template <typename S>
+struct SweepParts {
+  std::vector<std::vector<ulc::Vec3<S>>> parts;
+  std::vector<double> fraction;
+  Isometry3d deskew = Isometry3d::Identity();
 };
 
 /// A relative-pose factor between two layer-0 frames, from a window's BA.
@@ -106,17 +131,40 @@ inline std::vector<Mat6d> marginal_information(const WindowBaResult& ba, double 
   return out;
 }
 
+/// The sweep window of layer-0 frames [first, last): every non-empty part of their sweeps,
+/// and the next frame as the last sweep's end knot when asked for and there is one.
+template <typename S>
+SweepWindow<std::vector<ulc::Vec3<S>>> sweep_window(const std::vector<SweepParts<S>>& sweeps,
+                                                    std::size_t first, std::size_t last,
+                                                    bool end_knot) {
+  SweepWindow<std::vector<ulc::Vec3<S>>> sw;
+  for (std::size_t m = first; m < last; ++m) {
+    const SweepParts<S>& sp = sweeps[m];
+    sw.deskew.push_back(sp.deskew);
+    for (std::size_t j = 0; j < sp.parts.size() && j < sp.fraction.size(); ++j) {
+      if (sp.parts[j].empty()) continue;
+      sw.clouds.push_back(&sp.parts[j]);
+      sw.sweep.push_back(m - first);
+      sw.fraction.push_back(sp.fraction[j]);
+    }
+  }
+  if (end_knot && last < sweeps.size()) sw.deskew.push_back(sweeps[last].deskew);
+  return sw;
+}
+
 }  // namespace hierarchy_detail
 
 /// Builds and optimises the hierarchy of one LiDAR (see the header comment).
 template <typename S>
 HierarchyResult<S> build_hierarchy(const std::vector<std::vector<ulc::Vec3<S>>>& frames,
                                    const std::vector<Isometry3d>& poses,
-                                   const HierarchyOptions& options = {}) {
+                                   const HierarchyOptions& options = {},
+                                   const std::vector<SweepParts<S>>* sweeps = nullptr) {
   using Cloud = std::vector<ulc::Vec3<S>>;
   HierarchyResult<S> out;
   out.poses = poses;
   if (frames.size() != poses.size() || options.window < 2 || options.layers < 1) return out;
+  if (sweeps && sweeps->size() != frames.size()) sweeps = nullptr;
 
   std::vector<HierarchyMember<S>> layer(frames.size());
   for (std::size_t f = 0; f < frames.size(); ++f) {
@@ -131,6 +179,7 @@ HierarchyResult<S> build_hierarchy(const std::vector<std::vector<ulc::Vec3<S>>>&
       bool ran = false;
       std::vector<Mat6d> information;
       HierarchyMember<S> submap;
+      std::vector<HierarchyFactor> end_factor;  ///< to the end knot (continuous layer 0)
     };
     std::vector<Outcome> outcomes(n_windows);
     tbb::parallel_for(
@@ -145,25 +194,61 @@ HierarchyResult<S> build_hierarchy(const std::vector<std::vector<ulc::Vec3<S>>>&
               member_poses.push_back(out.poses[layer[m].begin]);
             }
             Outcome& o = outcomes[k];
+            // The submap is made of entries: the members, or at a continuous layer 0 the
+            // parts of their sweeps (entry_member: each entry's member).
+            std::vector<const Cloud*> entries = clouds;
+            std::vector<std::size_t> entry_member(clouds.size());
+            for (std::size_t m = 0; m < clouds.size(); ++m) entry_member[m] = m;
+            std::vector<Isometry3d> entry_poses;
             if (clouds.size() >= 2) {
               o.ran = true;
-              o.ba = window_ba(clouds, member_poses, options.ba);
+              std::size_t knots = clouds.size();
+              if (l == 0 && sweeps) {
+                const SweepWindow<Cloud> sw =
+                    hierarchy_detail::sweep_window(*sweeps, first, last, options.end_knot);
+                std::vector<Isometry3d> knot_poses = member_poses;
+                if (sw.deskew.size() > clouds.size()) knot_poses.push_back(out.poses[last]);
+                knots = knot_poses.size();
+                SweepBaResult sr = sweep_window_ba(sw, knot_poses, options.ba);
+                o.ba = std::move(sr.ba);
+                entries = sw.clouds;
+                entry_member = sw.sweep;
+                entry_poses = std::move(sr.entry_poses);
+              } else {
+                o.ba = window_ba(clouds, member_poses, options.ba);
+                entry_poses = o.ba.poses;
+              }
               const bool usable = o.ba.ok() || o.ba.status == WindowBaStatus::not_converged;
               if (usable)
                 o.information = hierarchy_detail::marginal_information(o.ba, options.min_sigma);
-              if (!usable || o.information.size() + 1 != clouds.size()) {
+              if (usable && o.information.size() + 1 == knots) {
+                if (knots > clouds.size() && options.end_knot_factor) {
+                  HierarchyFactor f;  // to the next frame, where the last sweep ends
+                  f.from = layer[first].begin;
+                  f.to = last;
+                  f.measured = o.ba.poses[0].inverse() * o.ba.poses.back();
+                  f.information = o.information.back();
+                  f.layer = 0;
+                  o.end_factor.push_back(f);
+                }
+                o.information.resize(clouds.size() - 1);
+                o.ba.poses.resize(clouds.size());
+              } else {
                 o.information.clear();
-                o.ba.poses = member_poses;  // unusable: keep the start
               }
-            } else {
-              o.ba.poses = member_poses;
             }
-            // The submap: every member's points in the first member's coordinates.
+            if (o.information.empty()) {  // no usable BA: keep the start
+              o.ba.poses = member_poses;
+              entry_poses.clear();
+              for (std::size_t e = 0; e < entries.size(); ++e)
+                entry_poses.push_back(member_poses[entry_member[e]]);
+            }
+            // The submap: every entry's points in the first member's coordinates.
             const Isometry3d first_inv = o.ba.poses[0].inverse();
             Cloud merged;
-            for (std::size_t m = 0; m < clouds.size(); ++m) {
-              const Isometry3d T = first_inv * o.ba.poses[m];
-              for (const auto& p : *clouds[m])
+            for (std::size_t e = 0; e < entries.size(); ++e) {
+              const Isometry3d T = first_inv * entry_poses[e];
+              for (const auto& p : *entries[e])
                 merged.push_back((T * p.template cast<double>()).template cast<S>());
             }
             o.submap.begin = layer[first].begin;
@@ -197,6 +282,8 @@ HierarchyResult<S> build_hierarchy(const std::vector<std::vector<ulc::Vec3<S>>>&
           out.factors.push_back(factor);
         }
       }
+      if (!o.information.empty())
+        out.factors.insert(out.factors.end(), o.end_factor.begin(), o.end_factor.end());
       next.push_back(std::move(o.submap));
     }
     out.members.push_back(std::move(layer));

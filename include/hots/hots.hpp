@@ -18,7 +18,9 @@
 //     a's first frame, b's pose interpolated to that instant (identity-free for jeep's
 //     odometry, whose map b is b's frame at a's first instant: T_mapa_mapb = C).
 //   - Frames are deskewed with the motion between their pose and the next frame's (constant
-//     velocity), then voxel-downsampled (frame_voxel).
+//     velocity), then voxel-downsampled (frame_voxel). With hierarchy.sweep_parts > 1 each
+//     frame's points are also split by time into that many parts, and the hierarchy's layer 0
+//     treats every frame as a sweep between its pose and the next frame's (sweep_ba.hpp).
 //   - Pose graph: one variable per frame of a and b (T_world_frame) and one for C; a's first
 //     frame is the gauge. Factors: every window's BA (information from its Hessian), every
 //     cross link (Huber), each boundary between two top-layer submaps (no window spans it:
@@ -197,24 +199,53 @@ inline double lap(std::chrono::steady_clock::time_point& start) {
 }
 
 /// Deskewed and downsampled copies of every stride-th frame (the others stay empty);
-/// sweep(k) gives frame k's motion over its sweep and the sweep's duration.
+/// sweep(k) gives frame k's motion over its sweep and the sweep's duration. With `sweeps`, each
+/// frame's kept points are also split by time into `parts` equal parts of the sweep
+/// (hierarchy.hpp, SweepParts; a frame without point times is one part at fraction 0).
 template <typename S, class Frames, class Sweep>
 std::vector<std::vector<ulc::Vec3<S>>> prepare_frames(const Frames& frames, const Sweep& sweep,
-                                                      double voxel, std::size_t stride = 1) {
+                                                      double voxel, std::size_t stride = 1,
+                                                      std::vector<SweepParts<S>>* sweeps = nullptr,
+                                                      int parts = 1) {
   std::vector<std::vector<ulc::Vec3<S>>> out(frames.size());
+  if (sweeps) sweeps->assign(frames.size(), SweepParts<S>{});
   stride = std::max<std::size_t>(stride, 1);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, frames.size(), 1),
-                    [&](const tbb::blocked_range<std::size_t>& r) {
-                      for (std::size_t k = r.begin(); k != r.end(); ++k) {
-                        if (k % stride != 0) continue;
-                        const std::pair<Isometry3d, double> motion = sweep(k);
-                        const auto deskewed = ulc::deskew(frames[k], motion.first, motion.second);
-                        const auto down = ulc::voxel_downsample(deskewed, voxel);
-                        const auto& pts = down.ok() ? down.cloud.points : deskewed.points;
-                        out[k].reserve(pts.size());
-                        for (const auto& p : pts) out[k].push_back(p.template cast<S>());
-                      }
-                    });
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, frames.size(), 1),
+      [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t k = r.begin(); k != r.end(); ++k) {
+          if (k % stride != 0) continue;
+          const std::pair<Isometry3d, double> motion = sweep(k);
+          auto deskewed = ulc::deskew(frames[k], motion.first, motion.second);
+          const bool timed = sweeps && ulc::traits::has_time(frames[k]) && motion.second > 0.0;
+          if (timed) {
+            deskewed.times.resize(deskewed.points.size());
+            for (std::size_t i = 0; i < deskewed.points.size(); ++i)
+              deskewed.times[i] = ulc::traits::time(frames[k], i);
+          }
+          const auto down = ulc::voxel_downsample(deskewed, voxel);
+          const auto& cloud = down.ok() ? down.cloud : deskewed;
+          out[k].reserve(cloud.points.size());
+          for (const auto& p : cloud.points) out[k].push_back(p.template cast<S>());
+          if (!sweeps) continue;
+          SweepParts<S>& sp = (*sweeps)[k];
+          sp.deskew = motion.first;
+          const bool split = timed && cloud.times.size() == out[k].size();
+          const int n = split ? std::max(parts, 1) : 1;
+          sp.parts.assign(static_cast<std::size_t>(n), {});
+          std::vector<double> time_sum(static_cast<std::size_t>(n), 0.0);
+          for (std::size_t i = 0; i < out[k].size(); ++i) {
+            const double f = split ? cloud.times[i] / motion.second : 0.0;
+            const auto j =
+                static_cast<std::size_t>(std::clamp(static_cast<int>(std::floor(f * n)), 0, n - 1));
+            sp.parts[j].push_back(out[k][i]);
+            time_sum[j] += f;
+          }
+          for (std::size_t j = 0; j < sp.parts.size(); ++j)
+            sp.fraction.push_back(
+                sp.parts[j].empty() ? 0.0 : time_sum[j] / static_cast<double>(sp.parts[j].size()));
+        }
+      });
   return out;
 }
 
@@ -228,12 +259,11 @@ inline std::pair<Isometry3d, double> own_sweep(const std::vector<double>& times,
 
 /// Every frame deskewed with its LiDAR's own poses (own_sweep).
 template <typename S, class Frames>
-std::vector<std::vector<ulc::Vec3<S>>> prepare_frames(const Frames& frames,
-                                                      const std::vector<double>& times,
-                                                      const std::vector<Isometry3d>& poses,
-                                                      double voxel) {
+std::vector<std::vector<ulc::Vec3<S>>> prepare_frames(
+    const Frames& frames, const std::vector<double>& times, const std::vector<Isometry3d>& poses,
+    double voxel, std::vector<SweepParts<S>>* sweeps = nullptr, int parts = 1) {
   return prepare_frames<S>(
-      frames, [&](std::size_t k) { return own_sweep(times, poses, k); }, voxel);
+      frames, [&](std::size_t k) { return own_sweep(times, poses, k); }, voxel, 1, sweeps, parts);
 }
 
 /// b's sweep from the base's trajectory T_world_a through C at b's instant t_b + dt:
@@ -316,12 +346,16 @@ RefineResult refine(const FramesA& frames_a, const std::vector<double>& times_a,
 
   RefineStatistics& st = result.statistics;
   auto clock = std::chrono::steady_clock::now();
-  const auto fa = d::prepare_frames<S>(frames_a, times_a, poses_a, options.frame_voxel);
-  const auto fb = d::prepare_frames<S>(frames_b, times_b, poses_b, options.frame_voxel);
+  const int parts = options.hierarchy.sweep_parts;
+  std::vector<SweepParts<S>> sweeps_a, sweeps_b;
+  const auto fa = d::prepare_frames<S>(frames_a, times_a, poses_a, options.frame_voxel,
+                                       parts > 1 ? &sweeps_a : nullptr, parts);
+  const auto fb = d::prepare_frames<S>(frames_b, times_b, poses_b, options.frame_voxel,
+                                       parts > 1 ? &sweeps_b : nullptr, parts);
   st.prepare_seconds = d::lap(clock);
 
-  const auto ha = build_hierarchy(fa, world_a, options.hierarchy);
-  const auto hb = build_hierarchy(fb, world_b, options.hierarchy);
+  const auto ha = build_hierarchy(fa, world_a, options.hierarchy, parts > 1 ? &sweeps_a : nullptr);
+  const auto hb = build_hierarchy(fb, world_b, options.hierarchy, parts > 1 ? &sweeps_b : nullptr);
   st.hierarchy_seconds = d::lap(clock);
   st.windows = ha.windows + hb.windows;
   st.failed_windows = ha.failed_windows + hb.failed_windows;

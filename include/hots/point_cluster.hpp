@@ -139,17 +139,30 @@ struct PlaneEvaluationOptions {
   double min_gap = 1e-9;
 };
 
+/// A plane's derivatives in factored form: per frame a, the forms w_a (6 x 3: w_a,k = u_k^T
+/// (dM/dxi_a) u, column 0 the gradient), e_a = d(u . s)/dxi_a and the second-order block of
+/// its own points, all for perturbations about the origin. The Hessian is
+///   H_ab = -2 e_a e_b^T / N + sum_k=1,2 2 w_a,k w_b,k^T / (lambda_0 - lambda_k) + [a = b] own_a,
+/// so a caller whose frames hang on other variables (sweep_ba.hpp) maps the forms by its
+/// Jacobians and sums the outer products there, in O(frames) instead of O(frames^2).
+struct PlaneForms {
+  double cost = 0.0;
+  bool degenerate = false;
+  double count = 0.0;            ///< N
+  Vec3d values = Vec3d::Zero();  ///< eigenvalues, ascending
+  std::vector<Eigen::Matrix<double, 6, 3>> w;
+  std::vector<Vec6d> e;
+  std::vector<Mat6d> own;
+};
+
 /// See the header comment. The derivation works with the points around c, x = T p - c, where
 /// a left perturbation of T about the origin is the perturbation [rho + phi x c; phi] about c;
 /// the chain rule through that linear map G = [[I, -[c]x], [0, I]] brings the result back.
-inline PlaneDerivatives evaluate_plane(const std::vector<FrameCluster>& frames,
-                                       const std::vector<Isometry3d>& poses, const Vec3d& c,
-                                       const PlaneEvaluationOptions& options = {}) {
+inline PlaneForms plane_forms(const std::vector<FrameCluster>& frames,
+                              const std::vector<Isometry3d>& poses, const Vec3d& c,
+                              const PlaneEvaluationOptions& options = {}) {
   const std::size_t K = frames.size();
-  PlaneDerivatives out;
-  out.gradient = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(6 * K));
-  out.hessian =
-      Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(6 * K), static_cast<Eigen::Index>(6 * K));
+  PlaneForms out;
   // Each frame's points placed around c.
   std::vector<PointCluster> placed;
   placed.reserve(K);
@@ -166,6 +179,8 @@ inline PlaneDerivatives evaluate_plane(const std::vector<FrameCluster>& frames,
   const Mat3d M = merged.scatter();
   const PlaneEigen eig = plane_eigen(M);
   out.cost = eig.values(0);
+  out.count = N;
+  out.values = eig.values;
   const double gap = eig.values(1) - eig.values(0);
   if (!(gap > options.min_gap * (M.trace() + 1e-300))) {
     out.degenerate = true;
@@ -174,14 +189,15 @@ inline PlaneDerivatives evaluate_plane(const std::vector<FrameCluster>& frames,
   const Vec3d u = eig.vectors.col(0);
   const Vec3d mu = merged.sum / N;
   const double u_mu = u.dot(mu);
-
-  // Per frame: the first-order forms w_k = u_k^T (dM/dxi_a) u for k = 0, 1, 2 (k = 0 is the
-  // gradient) and e_a = d(u . s)/dxi_a, all in the coordinates about c.
-  std::vector<Eigen::Matrix<double, 6, 3>> w(K);
-  std::vector<Vec6d> e(K);
+  Mat6d G = Mat6d::Identity();
+  G.topRightCorner<3, 3>() = -ulc::hat(c);
+  out.w.resize(K);
+  out.e.resize(K);
+  out.own.resize(K);
   for (std::size_t a = 0; a < K; ++a) {
     const PointCluster& P = placed[a];
     const Vec3d Au = P.sum_outer * u;
+    Eigen::Matrix<double, 6, 3> w;
     for (int k = 0; k < 3; ++k) {
       const Vec3d uk = eig.vectors.col(k);
       const Vec3d Auk = P.sum_outer * uk;
@@ -189,26 +205,12 @@ inline PlaneDerivatives evaluate_plane(const std::vector<FrameCluster>& frames,
       Vec6d col;
       col.head<3>() = uk * (u.dot(P.sum) - P.count * u_mu) + u * (uk.dot(P.sum) - P.count * uk_mu);
       col.tail<3>() = Au.cross(uk) + Auk.cross(u) - P.sum.cross(uk) * u_mu - P.sum.cross(u) * uk_mu;
-      w[a].col(k) = col;
+      w.col(k) = col;
     }
-    e[a].head<3>() = P.count * u;
-    e[a].tail<3>() = P.sum.cross(u);
-  }
-
-  Eigen::VectorXd g(6 * K);
-  Eigen::MatrixXd H(6 * K, 6 * K);
-  for (std::size_t a = 0; a < K; ++a) {
-    const auto ia = static_cast<Eigen::Index>(6 * a);
-    g.segment<6>(ia) = w[a].col(0);  // u^T dM u = w_0 (the two symmetric terms are in w_0)
-    for (std::size_t b = 0; b < K; ++b) {
-      const auto ib = static_cast<Eigen::Index>(6 * b);
-      Mat6d block = -2.0 * e[a] * e[b].transpose() / N;
-      for (int k = 1; k < 3; ++k)
-        block += 2.0 * w[a].col(k) * w[b].col(k).transpose() / (eig.values(0) - eig.values(k));
-      H.block<6, 6>(ia, ib) = block;
-    }
+    Vec6d e;
+    e.head<3>() = P.count * u;
+    e.tail<3>() = P.sum.cross(u);
     // Second-order terms of frame a's own points.
-    const PointCluster& P = placed[a];
     const Mat3d U = ulc::hat(u);
     const Vec3d su = P.sum.cross(u);
     Mat6d own = Mat6d::Zero();
@@ -216,7 +218,6 @@ inline PlaneDerivatives evaluate_plane(const std::vector<FrameCluster>& frames,
     own.topRightCorner<3, 3>() = 2.0 * u * su.transpose();
     own.bottomLeftCorner<3, 3>() = 2.0 * su * u.transpose();
     own.bottomRightCorner<3, 3>() = 2.0 * U * P.sum_outer * U.transpose();
-    const Vec3d Au = P.sum_outer * u;
     const Mat3d B3 =
         u * (Au - u_mu * P.sum).transpose() - (u.dot(Au) - u_mu * u.dot(P.sum)) * Mat3d::Identity();
     own.bottomRightCorner<3, 3>() += B3 + B3.transpose();
@@ -224,19 +225,44 @@ inline PlaneDerivatives evaluate_plane(const std::vector<FrameCluster>& frames,
     const Mat3d D = -beta * U;  // d^2 / dphi drho
     own.bottomLeftCorner<3, 3>() += D;
     own.topRightCorner<3, 3>() += D.transpose();
-    H.block<6, 6>(ia, ia) += own;
+    // Back from perturbations about c to perturbations about the origin: xi_c = G xi.
+    out.w[a] = G.transpose() * w;
+    out.e[a] = G.transpose() * e;
+    out.own[a] = G.transpose() * own * G;
   }
+  return out;
+}
 
-  // Back from perturbations about c to perturbations about the origin: xi_c = G xi.
-  Mat6d G = Mat6d::Identity();
-  G.topRightCorner<3, 3>() = -ulc::hat(c);
+/// The Hessian block between two frames (or two mapped variables) from their forms.
+inline Mat6d plane_hessian_block(const PlaneForms& f, const Eigen::Matrix<double, 6, 3>& wa,
+                                 const Vec6d& ea, const Eigen::Matrix<double, 6, 3>& wb,
+                                 const Vec6d& eb) {
+  Mat6d block = -2.0 * ea * eb.transpose() / f.count;
+  for (int k = 1; k < 3; ++k)
+    block += 2.0 * wa.col(k) * wb.col(k).transpose() / (f.values(0) - f.values(k));
+  return block;
+}
+
+/// Cost, gradient and Hessian of one plane (see the header comment and PlaneForms).
+inline PlaneDerivatives evaluate_plane(const std::vector<FrameCluster>& frames,
+                                       const std::vector<Isometry3d>& poses, const Vec3d& c,
+                                       const PlaneEvaluationOptions& options = {}) {
+  const std::size_t K = frames.size();
+  PlaneDerivatives out;
+  out.gradient = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(6 * K));
+  out.hessian =
+      Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(6 * K), static_cast<Eigen::Index>(6 * K));
+  const PlaneForms f = plane_forms(frames, poses, c, options);
+  out.cost = f.cost;
+  out.degenerate = f.degenerate;
+  if (f.degenerate) return out;
   for (std::size_t a = 0; a < K; ++a) {
     const auto ia = static_cast<Eigen::Index>(6 * a);
-    out.gradient.segment<6>(ia) = G.transpose() * g.segment<6>(ia);
-    for (std::size_t b = 0; b < K; ++b) {
-      const auto ib = static_cast<Eigen::Index>(6 * b);
-      out.hessian.block<6, 6>(ia, ib) = G.transpose() * H.block<6, 6>(ia, ib) * G;
-    }
+    out.gradient.segment<6>(ia) = f.w[a].col(0);
+    for (std::size_t b = 0; b < K; ++b)
+      out.hessian.block<6, 6>(ia, static_cast<Eigen::Index>(6 * b)) =
+          plane_hessian_block(f, f.w[a], f.e[a], f.w[b], f.e[b]);
+    out.hessian.block<6, 6>(ia, ia) += f.own[a];
   }
   return out;
 }

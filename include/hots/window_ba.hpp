@@ -145,6 +145,103 @@ inline bool valid_options(const WindowBaOptions& o) {
          o.grain >= 1;
 }
 
+/// Levenberg-Marquardt over the poses x[1..] (x[0] is the gauge) on the planes extracted by
+/// the caller: evaluate(x) gives the Sums, cost(x) the cost alone. Nielsen's damping rule (see
+/// the header comment). Returns whether a stopping test was met; `sums` holds the last
+/// accepted evaluation, `iterations` counts the steps tried.
+template <class Evaluate, class Cost>
+bool levenberg_marquardt(std::vector<Isometry3d>& x, Sums& sums, const Evaluate& evaluate,
+                         const Cost& cost, const WindowBaOptions& o, int& iterations) {
+  const auto m = static_cast<Eigen::Index>(6 * (x.size() - 1));
+  double mu = o.initial_damping * std::max(sums.H.diagonal().tail(m).maxCoeff(), 1e-12);
+  double nu = 2.0;
+  for (int it = 0; it < o.max_iterations; ++it) {
+    ++iterations;
+    const Eigen::MatrixXd H = sums.H.bottomRightCorner(m, m);
+    const Eigen::VectorXd g = sums.g.tail(m);
+    const Eigen::LLT<Eigen::MatrixXd> llt(H + mu * Eigen::MatrixXd::Identity(m, m));
+    if (llt.info() != Eigen::Success) {  // H indefinite here: damp harder
+      mu *= nu;
+      nu *= 2.0;
+      continue;
+    }
+    const Eigen::VectorXd step = llt.solve(-g);
+    if (!step.allFinite()) return false;
+    if (step.cwiseAbs().maxCoeff() < o.step_tolerance) return true;
+    std::vector<Isometry3d> trial = x;
+    for (std::size_t i = 1; i < x.size(); ++i)
+      trial[i] =
+          ulc::se3_exp(Vec6d(step.segment<6>(static_cast<Eigen::Index>(6 * (i - 1))))) * x[i];
+    const double trial_cost = cost(trial);
+    const double predicted = -(g.dot(step) + 0.5 * step.dot(H * step));
+    const double actual = sums.cost - trial_cost;
+    const double rho = predicted > 0.0 ? actual / predicted : -1.0;
+    if (rho > 0.0) {
+      x = trial;
+      const double before = sums.cost;
+      sums = evaluate(x);
+      mu *= std::max(1.0 / 3.0, 1.0 - std::pow(2.0 * rho - 1.0, 3));
+      nu = 2.0;
+      if (actual < o.cost_tolerance * before) return true;
+    } else {
+      mu *= nu;
+      nu *= 2.0;
+    }
+  }
+  return false;
+}
+
+/// Poses in the window frame (the first pose's): the first is exactly the identity.
+inline std::vector<Isometry3d> in_window_frame(const std::vector<Isometry3d>& poses_world) {
+  const Isometry3d origin_inv = poses_world[0].inverse();
+  std::vector<Isometry3d> x(poses_world.size());
+  for (std::size_t i = 0; i < x.size(); ++i) x[i] = origin_inv * poses_world[i];
+  x[0] = Isometry3d::Identity();
+  return x;
+}
+
+/// The rounds shared by the window BAs: planes extracted from the clouds placed by
+/// place(x) (the entries' poses), then LM over x on evaluate(planes, x) (Sums over x). Leaves x
+/// refined and fills result's planes, points, costs, Hessian, noise and status.
+template <class Cloud, class Place, class Evaluate>
+void run_rounds(const std::vector<const Cloud*>& clouds, std::vector<Isometry3d>& x,
+                const Place& place, const Evaluate& evaluate, const WindowBaOptions& options,
+                WindowBaResult& result) {
+  const auto n = static_cast<Eigen::Index>(6 * x.size());
+  std::vector<Plane> planes;
+  Sums sums;
+  bool converged = false;
+  for (int round = 0; round < options.rounds; ++round) {
+    planes = extract_planes(clouds, place(x), options.planes);
+    result.planes = planes.size();
+    result.points = 0;
+    for (const Plane& p : planes) result.points += p.points;
+    if (planes.size() < options.min_planes) {
+      result.status = WindowBaStatus::too_few_planes;
+      result.reason = "fewer planar cells than min_planes";
+      result.hessian = Eigen::MatrixXd::Zero(n, n);
+      result.gradient = Eigen::VectorXd::Zero(n);
+      return;
+    }
+    sums = evaluate(planes, x);
+    if (round == 0) result.initial_cost = sums.cost;
+    converged = levenberg_marquardt(
+        x, sums, [&](const std::vector<Isometry3d>& at) { return evaluate(planes, at); },
+        [&](const std::vector<Isometry3d>& at) { return cost(planes, place(at), options); },
+        options, result.iterations);
+  }
+  result.cost = sums.cost;
+  result.hessian = sums.H;
+  result.gradient = sums.g;
+  result.degenerate_planes = sums.degenerate;
+  const double dof = static_cast<double>(result.points) - 3.0 * static_cast<double>(result.planes);
+  result.noise_variance = dof > 0.0 ? result.cost / dof : 0.0;
+  if (!converged && options.max_iterations > 0) {
+    result.status = WindowBaStatus::not_converged;
+    result.reason = "max_iterations reached before the step or the cost change was small";
+  }
+}
+
 }  // namespace window_ba_detail
 
 /// Refines the poses of frames[1..] with frames[0] fixed (see the header comment).
@@ -170,83 +267,15 @@ WindowBaResult window_ba(const std::vector<const Cloud*>& frames,
     }
   }
   const Isometry3d origin = poses_world[0];
-  const Isometry3d origin_inv = origin.inverse();
-  std::vector<Isometry3d> x(W);
-  for (std::size_t i = 0; i < W; ++i) x[i] = origin_inv * poses_world[i];
-  x[0] = Isometry3d::Identity();
+  std::vector<Isometry3d> x = d::in_window_frame(poses_world);
 
-  const auto n = static_cast<Eigen::Index>(6 * W);
-  const Eigen::Index m = n - 6;  // the gauge's block is left out
-  std::vector<Plane> planes;
-  d::Sums sums;
-  bool converged = false;
-  for (int round = 0; round < options.rounds; ++round) {
-    planes = extract_planes(frames, x, options.planes);
-    result.planes = planes.size();
-    result.points = 0;
-    for (const Plane& p : planes) result.points += p.points;
-    if (planes.size() < options.min_planes) {
-      result.status = WindowBaStatus::too_few_planes;
-      result.reason = "fewer planar cells than min_planes";
-      result.hessian = Eigen::MatrixXd::Zero(n, n);
-      result.gradient = Eigen::VectorXd::Zero(n);
-      for (std::size_t i = 1; i < W; ++i) result.poses[i] = origin * x[i];
-      return result;
-    }
-    sums = d::evaluate(planes, x, options);
-    if (round == 0) result.initial_cost = sums.cost;
-    double mu = options.initial_damping * std::max(sums.H.diagonal().tail(m).maxCoeff(), 1e-12);
-    double nu = 2.0;
-    converged = false;
-    for (int it = 0; it < options.max_iterations && !converged; ++it) {
-      ++result.iterations;
-      const Eigen::MatrixXd H = sums.H.bottomRightCorner(m, m);
-      const Eigen::VectorXd g = sums.g.tail(m);
-      const Eigen::LLT<Eigen::MatrixXd> llt(H + mu * Eigen::MatrixXd::Identity(m, m));
-      if (llt.info() != Eigen::Success) {  // H indefinite here: damp harder
-        mu *= nu;
-        nu *= 2.0;
-        continue;
-      }
-      const Eigen::VectorXd step = llt.solve(-g);
-      if (!step.allFinite()) break;
-      if (step.cwiseAbs().maxCoeff() < options.step_tolerance) {
-        converged = true;
-        break;
-      }
-      std::vector<Isometry3d> trial = x;
-      for (std::size_t i = 1; i < W; ++i)
-        trial[i] =
-            ulc::se3_exp(Vec6d(step.segment<6>(static_cast<Eigen::Index>(6 * (i - 1))))) * x[i];
-      const double trial_cost = d::cost(planes, trial, options);
-      const double predicted = -(g.dot(step) + 0.5 * step.dot(H * step));
-      const double actual = sums.cost - trial_cost;
-      const double rho = predicted > 0.0 ? actual / predicted : -1.0;
-      if (rho > 0.0) {
-        x = trial;
-        const double before = sums.cost;
-        sums = d::evaluate(planes, x, options);
-        mu *= std::max(1.0 / 3.0, 1.0 - std::pow(2.0 * rho - 1.0, 3));
-        nu = 2.0;
-        if (actual < options.cost_tolerance * before) converged = true;
-      } else {
-        mu *= nu;
-        nu *= 2.0;
-      }
-    }
-  }
-
-  result.cost = sums.cost;
-  result.hessian = sums.H;
-  result.gradient = sums.g;
-  result.degenerate_planes = sums.degenerate;
-  const double dof = static_cast<double>(result.points) - 3.0 * static_cast<double>(result.planes);
-  result.noise_variance = dof > 0.0 ? result.cost / dof : 0.0;
+  d::run_rounds(
+      frames, x, [](const std::vector<Isometry3d>& at) { return at; },
+      [&](const std::vector<Plane>& planes, const std::vector<Isometry3d>& at) {
+        return d::evaluate(planes, at, options);
+      },
+      options, result);
   for (std::size_t i = 1; i < W; ++i) result.poses[i] = origin * x[i];
-  if (!converged && options.max_iterations > 0) {
-    result.status = WindowBaStatus::not_converged;
-    result.reason = "max_iterations reached before the step or the cost change was small";
-  }
   return result;
 }
 
