@@ -42,7 +42,8 @@
 // simulator's trajectory, both in the base frame at its first timestamp; ate_aligned_*: the same
 // after the best rigid alignment of the whole trajectory (the TUM/evo definition). The stderr line
 // of each run adds the relative pose error (RMS translation error of the motion over 1, 5, 25, 125,
-// 250, 500 frames), odometry -> HOTS: which time scales HOTS improves.
+// 250, 500 frames), odometry -> HOTS: which time scales HOTS improves, and the wall time of
+// HOTS's phases (RefineStatistics: prepare, hierarchy, links, graph, sync, sequence).
 // A 60 s full-rate drive holds every frame in memory (several GB for 64-beam rigs):
 // --decimation N keeps every Nth point.
 #include <tbb/task_arena.h>
