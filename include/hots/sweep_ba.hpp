@@ -116,69 +116,46 @@ window_ba_detail::Sums evaluate(const std::vector<Plane>& planes, const SweepWin
   std::vector<Eigen::Matrix<double, 6, 12>> jacobians(entries.size());
   for (std::size_t e = 0; e < entries.size(); ++e) jacobians[e] = entry_jacobian(w, x, e);
   const std::size_t V = x.size();
-  const auto n = static_cast<Eigen::Index>(6 * V);
-  window_ba_detail::Sums identity;
-  identity.H = Eigen::MatrixXd::Zero(n, n);
-  identity.g = Eigen::VectorXd::Zero(n);
-  const auto body = [&](std::size_t begin, std::size_t end, window_ba_detail::Sums acc) {
-    std::vector<std::size_t> vars;
-    std::vector<Mat63> W;
-    std::vector<Vec6d> E;
-    for (std::size_t p = begin; p < end; ++p) {
-      const Plane& plane = planes[p];
-      const PlaneForms f = plane_forms(plane.frames, entries, plane.anchor, o.evaluation);
-      acc.cost += f.cost;
-      if (f.degenerate) {
-        ++acc.degenerate;
-        continue;
-      }
-      vars.clear();
-      W.clear();
-      E.clear();
-      for (std::size_t a = 0; a < plane.frames.size(); ++a) {
-        const std::size_t e = plane.frames[a].frame, k = w.sweep[e];
-        const std::size_t sides = k + 1 < V ? 2 : 1;
-        for (std::size_t side = 0; side < sides; ++side) {
-          const auto Ja = jacobians[e].template middleCols<6>(static_cast<Eigen::Index>(6 * side));
-          const std::size_t var = k + side;
-          const auto it = std::find(vars.begin(), vars.end(), var);
-          const std::size_t slot = static_cast<std::size_t>(it - vars.begin());
-          if (it == vars.end()) {
-            vars.push_back(var);
-            W.push_back(Mat63::Zero());
-            E.push_back(Vec6d::Zero());
-          }
-          W[slot] += Ja.transpose() * f.w[a];
-          E[slot] += Ja.transpose() * f.e[a];
-          // The entry's own second-order block, through both of its variables.
-          const auto ia = static_cast<Eigen::Index>(6 * var);
-          for (std::size_t side_b = 0; side_b < sides; ++side_b) {
-            const auto Jb =
-                jacobians[e].template middleCols<6>(static_cast<Eigen::Index>(6 * side_b));
-            acc.H.template block<6, 6>(ia, static_cast<Eigen::Index>(6 * (k + side_b))) +=
-                Ja.transpose() * f.own[a] * Jb;
+  window_ba_detail::Sums out = window_ba_detail::sum_planes(
+      planes, entries, V, o,
+      [&](const Plane& plane, const PlaneForms& f, window_ba_detail::Sums& acc) {
+        std::vector<std::size_t> vars;  // the plane's variables, and their mapped forms
+        std::vector<Mat63> W;
+        std::vector<Vec6d> E;
+        for (std::size_t a = 0; a < plane.frames.size(); ++a) {
+          const std::size_t e = plane.frames[a].frame, k = w.sweep[e];
+          const std::size_t sides = k + 1 < V ? 2 : 1;
+          for (std::size_t side = 0; side < sides; ++side) {
+            const auto Ja =
+                jacobians[e].template middleCols<6>(static_cast<Eigen::Index>(6 * side));
+            const std::size_t var = k + side;
+            const auto it = std::find(vars.begin(), vars.end(), var);
+            const std::size_t slot = static_cast<std::size_t>(it - vars.begin());
+            if (it == vars.end()) {
+              vars.push_back(var);
+              W.push_back(Mat63::Zero());
+              E.push_back(Vec6d::Zero());
+            }
+            W[slot] += Ja.transpose() * f.w[a];
+            E[slot] += Ja.transpose() * f.e[a];
+            // The entry's own second-order block, through both of its variables.
+            const auto ia = static_cast<Eigen::Index>(6 * var);
+            for (std::size_t side_b = 0; side_b < sides; ++side_b) {
+              const auto Jb =
+                  jacobians[e].template middleCols<6>(static_cast<Eigen::Index>(6 * side_b));
+              acc.H.template block<6, 6>(ia, static_cast<Eigen::Index>(6 * (k + side_b))) +=
+                  Ja.transpose() * f.own[a] * Jb;
+            }
           }
         }
-      }
-      for (std::size_t i = 0; i < vars.size(); ++i) {
-        const auto ia = static_cast<Eigen::Index>(6 * vars[i]);
-        acc.g.template segment<6>(ia) += W[i].col(0);
-        for (std::size_t j = 0; j < vars.size(); ++j)
-          acc.H.template block<6, 6>(ia, static_cast<Eigen::Index>(6 * vars[j])) +=
-              plane_hessian_block(f, W[i], E[i], W[j], E[j]);
-      }
-    }
-    return acc;
-  };
-  const auto join = [](window_ba_detail::Sums a, const window_ba_detail::Sums& b) {
-    a.H += b.H;
-    a.g += b.g;
-    a.cost += b.cost;
-    a.degenerate += b.degenerate;
-    return a;
-  };
-  window_ba_detail::Sums out =
-      ulc::deterministic_reduce(planes.size(), identity, body, join, o.grain);
+        for (std::size_t i = 0; i < vars.size(); ++i) {
+          const auto ia = static_cast<Eigen::Index>(6 * vars[i]);
+          acc.g.template segment<6>(ia) += W[i].col(0);
+          for (std::size_t j = 0; j < vars.size(); ++j)
+            acc.H.template block<6, 6>(ia, static_cast<Eigen::Index>(6 * vars[j])) +=
+                plane_hessian_block(f, W[i], E[i], W[j], E[j]);
+        }
+      });
   out.H = 0.5 * (out.H + out.H.transpose());
   return out;
 }
@@ -208,18 +185,15 @@ SweepBaResult sweep_window_ba(const SweepWindow<Cloud>& window,
     result.reason = "sweep window: inconsistent entries, poses or options";
     return out;
   }
-  const Isometry3d origin = poses_world[0];
-  std::vector<Isometry3d> x = d::in_window_frame(poses_world);
-
-  d::run_rounds(
-      window.clouds, x,
+  const std::vector<Isometry3d> x = d::run_rounds(
+      window.clouds, poses_world,
       [&](const std::vector<Isometry3d>& at) { return sd::entry_poses(window, at); },
       [&](const std::vector<Plane>& planes, const std::vector<Isometry3d>& at) {
         return sd::evaluate(planes, window, at, options);
       },
       options, result);
-  for (std::size_t i = 1; i < V; ++i) result.poses[i] = origin * x[i];
-  for (const Isometry3d& P : sd::entry_poses(window, x)) out.entry_poses.push_back(origin * P);
+  for (const Isometry3d& P : sd::entry_poses(window, x))
+    out.entry_poses.push_back(poses_world[0] * P);
   return out;
 }
 

@@ -90,30 +90,26 @@ struct Sums {
   std::size_t degenerate = 0;
 };
 
-inline Sums evaluate(const std::vector<Plane>& planes, const std::vector<Isometry3d>& poses,
-                     const WindowBaOptions& o) {
-  const auto n = static_cast<Eigen::Index>(6 * poses.size());
+/// Sums over the planes in fixed chunks (the same bits for any number of threads): each
+/// plane's factored derivatives (PlaneForms) at the entries' poses, its cost and degeneracy
+/// counted here; add_plane(plane, forms, acc) adds its gradient and Hessian to acc (over
+/// `variables` poses).
+template <class AddPlane>
+Sums sum_planes(const std::vector<Plane>& planes, const std::vector<Isometry3d>& entry_poses,
+                std::size_t variables, const WindowBaOptions& o, const AddPlane& add_plane) {
+  const auto n = static_cast<Eigen::Index>(6 * variables);
   Sums identity;
   identity.H = Eigen::MatrixXd::Zero(n, n);
   identity.g = Eigen::VectorXd::Zero(n);
   const auto body = [&](std::size_t begin, std::size_t end, Sums acc) {
     for (std::size_t p = begin; p < end; ++p) {
-      const Plane& plane = planes[p];
-      const PlaneDerivatives d = evaluate_plane(plane.frames, poses, plane.anchor, o.evaluation);
-      acc.cost += d.cost;
-      if (d.degenerate) {
+      const PlaneForms f =
+          plane_forms(planes[p].frames, entry_poses, planes[p].anchor, o.evaluation);
+      acc.cost += f.cost;
+      if (f.degenerate)
         ++acc.degenerate;
-        continue;
-      }
-      for (std::size_t a = 0; a < plane.frames.size(); ++a) {
-        const auto ia = static_cast<Eigen::Index>(6 * plane.frames[a].frame);
-        const auto la = static_cast<Eigen::Index>(6 * a);
-        acc.g.segment<6>(ia) += d.gradient.segment<6>(la);
-        for (std::size_t b = 0; b < plane.frames.size(); ++b) {
-          const auto ib = static_cast<Eigen::Index>(6 * plane.frames[b].frame);
-          acc.H.block<6, 6>(ia, ib) += d.hessian.block<6, 6>(la, static_cast<Eigen::Index>(6 * b));
-        }
-      }
+      else
+        add_plane(planes[p], f, acc);
     }
     return acc;
   };
@@ -125,6 +121,23 @@ inline Sums evaluate(const std::vector<Plane>& planes, const std::vector<Isometr
     return a;
   };
   return ulc::deterministic_reduce(planes.size(), identity, body, join, o.grain);
+}
+
+inline Sums evaluate(const std::vector<Plane>& planes, const std::vector<Isometry3d>& poses,
+                     const WindowBaOptions& o) {
+  return sum_planes(planes, poses, poses.size(), o,
+                    [](const Plane& plane, const PlaneForms& f, Sums& acc) {
+                      for (std::size_t a = 0; a < plane.frames.size(); ++a) {
+                        const auto ia = static_cast<Eigen::Index>(6 * plane.frames[a].frame);
+                        acc.g.segment<6>(ia) += f.w[a].col(0);
+                        for (std::size_t b = 0; b < plane.frames.size(); ++b) {
+                          Mat6d block = plane_hessian_block(f, f.w[a], f.e[a], f.w[b], f.e[b]);
+                          if (a == b) block += f.own[a];
+                          const auto ib = static_cast<Eigen::Index>(6 * plane.frames[b].frame);
+                          acc.H.block<6, 6>(ia, ib) += block;
+                        }
+                      }
+                    });
 }
 
 inline double cost(const std::vector<Plane>& planes, const std::vector<Isometry3d>& poses,
@@ -200,13 +213,20 @@ inline std::vector<Isometry3d> in_window_frame(const std::vector<Isometry3d>& po
   return x;
 }
 
-/// The rounds shared by the window BAs: planes extracted from the clouds placed by
-/// place(x) (the entries' poses), then LM over x on evaluate(planes, x) (Sums over x). Leaves x
-/// refined and fills result's planes, points, costs, Hessian, noise and status.
+/// The rounds shared by the window BAs, on the variables x = poses_world in the window frame
+/// (in_window_frame): planes extracted from the clouds placed by place(x) (the entries' poses),
+/// then LM over x on evaluate(planes, x) (Sums over x). Fills result's poses (back in the
+/// world), planes, points, costs, Hessian, noise and status; returns the refined x.
 template <class Cloud, class Place, class Evaluate>
-void run_rounds(const std::vector<const Cloud*>& clouds, std::vector<Isometry3d>& x,
-                const Place& place, const Evaluate& evaluate, const WindowBaOptions& options,
-                WindowBaResult& result) {
+std::vector<Isometry3d> run_rounds(const std::vector<const Cloud*>& clouds,
+                                   const std::vector<Isometry3d>& poses_world, const Place& place,
+                                   const Evaluate& evaluate, const WindowBaOptions& options,
+                                   WindowBaResult& result) {
+  std::vector<Isometry3d> x = in_window_frame(poses_world);
+  const auto to_world = [&] {
+    result.poses = poses_world;
+    for (std::size_t i = 1; i < x.size(); ++i) result.poses[i] = poses_world[0] * x[i];
+  };
   const auto n = static_cast<Eigen::Index>(6 * x.size());
   std::vector<Plane> planes;
   Sums sums;
@@ -221,7 +241,8 @@ void run_rounds(const std::vector<const Cloud*>& clouds, std::vector<Isometry3d>
       result.reason = "fewer planar cells than min_planes";
       result.hessian = Eigen::MatrixXd::Zero(n, n);
       result.gradient = Eigen::VectorXd::Zero(n);
-      return;
+      to_world();
+      return x;
     }
     sums = evaluate(planes, x);
     if (round == 0) result.initial_cost = sums.cost;
@@ -240,6 +261,8 @@ void run_rounds(const std::vector<const Cloud*>& clouds, std::vector<Isometry3d>
     result.status = WindowBaStatus::not_converged;
     result.reason = "max_iterations reached before the step or the cost change was small";
   }
+  to_world();
+  return x;
 }
 
 }  // namespace window_ba_detail
@@ -266,16 +289,12 @@ WindowBaResult window_ba(const std::vector<const Cloud*>& frames,
       return result;
     }
   }
-  const Isometry3d origin = poses_world[0];
-  std::vector<Isometry3d> x = d::in_window_frame(poses_world);
-
   d::run_rounds(
-      frames, x, [](const std::vector<Isometry3d>& at) { return at; },
+      frames, poses_world, [](const std::vector<Isometry3d>& at) { return at; },
       [&](const std::vector<Plane>& planes, const std::vector<Isometry3d>& at) {
         return d::evaluate(planes, at, options);
       },
       options, result);
-  for (std::size_t i = 1; i < W; ++i) result.poses[i] = origin * x[i];
   return result;
 }
 
