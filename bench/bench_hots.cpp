@@ -111,6 +111,7 @@ void apply_hots_setting(hots::RefineOptions& o, const std::string& setting) {
       {"plane_distance", [&] { planes.max_distance = v; }},
       {"frame_voxel", [&] { o.frame_voxel = v; }},
       {"submap_voxel", [&] { o.hierarchy.submap_voxel = v; }},
+      {"boundary_bridges", [&] { o.boundary_bridges = v != 0.0; }},
       {"boundary_registration", [&] { o.boundary_registration = v != 0.0; }},
       {"boundary_radius_m", [&] { o.boundary_radius_m = v; }},
       {"boundary_sigma_m", [&] { o.boundary_sigma_m = v; }},
@@ -323,7 +324,8 @@ Run one_run(const std::string& scenario, double offset_s, std::size_t run, const
     const auto& st = h.statistics;
     out.links = "cross " + std::to_string(st.cross_links) + "/" +
                 std::to_string(st.cross_links_attempted) + ", boundaries " +
-                std::to_string(st.boundary_links) + "/" + std::to_string(st.boundary_factors);
+                std::to_string(st.boundary_links) + "/" + std::to_string(st.boundary_factors) +
+                ", bridged " + std::to_string(st.boundary_bridges);
     // Where HOTS's time goes (RefineStatistics' phase clocks).
     std::ostringstream phases;
     phases << "; phases s: prepare " << st.prepare_seconds << ", hierarchy " << st.hierarchy_seconds

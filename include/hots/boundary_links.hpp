@@ -19,6 +19,8 @@
 //     4-6 of 8 boundaries registered). A 40 m crop registered all 8 but did not make the
 //     trajectory better (best-aligned ATE, seeds 1-3: 2.06 / 3.96 / 2.43 cm whole, 1.94 /
 //     5.28 / 2.60 cm cropped; docs/BENCHMARKS.md, session 9), so the default is no crop.
+//   - Boundaries marked in `skip` (those a bridge BA already ties, boundary_bridges.hpp) are
+//     not registered.
 //   - A boundary whose registration is unusable (empty submaps at the ends, too few inliers)
 //     gets no link; refine() then falls back to the odometry's step there.
 //   - Registrations run as TBB tasks, one slot each; links are in boundary order. Nothing here
@@ -57,7 +59,8 @@ std::vector<ulc::Vec3<S>> within(const std::vector<ulc::Vec3<S>>& cloud, const u
 template <typename S>
 std::vector<std::optional<CrossLink>> boundary_links(
     const HierarchyResult<S>& h, const std::vector<std::vector<ulc::Vec3<S>>>& frames,
-    const std::vector<Isometry3d>& poses, const CrossLinkOptions& options, double radius = 0.0) {
+    const std::vector<Isometry3d>& poses, const CrossLinkOptions& options, double radius = 0.0,
+    const std::vector<bool>* skip = nullptr) {
   if (h.members.empty() || h.members.back().size() < 2) return {};
   const auto& top = h.members.back();
   const bool frames_are_members = h.members.size() == 1;  // no BA layer ran: frames on top
@@ -67,6 +70,7 @@ std::vector<std::optional<CrossLink>> boundary_links(
       tbb::blocked_range<std::size_t>(0, out.size(), 1),
       [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t m = r.begin(); m != r.end(); ++m) {
+          if (skip && m < skip->size() && (*skip)[m]) continue;
           const auto& first = top[m];
           const auto& second = top[m + 1];
           const auto& target = frames_are_members ? frames[first.begin] : first.cloud;

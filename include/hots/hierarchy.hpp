@@ -18,6 +18,8 @@
 //     the k-th 6x6 block of (H / (2 sigma^2))^-1 (H the BA Hessian without the gauge block,
 //     sigma^2 its noise estimate), i.e. the marginal information of that relative pose.
 //   - Submap clouds are voxel-downsampled (submap_voxel) to bound the upper layers' work.
+//   - The top layer's windows share no member: boundary_bridges.hpp can tie them afterwards
+//     (one more BA per boundary, over the members on both sides).
 //   - Continuous-time layer 0 (optional: the caller passes each frame's SweepParts): the
 //     window's BA is sweep_ba.hpp's, whose variables are the members' poses plus, with
 //     end_knot and a next frame, that frame's pose (where the last sweep ends); the submap

@@ -24,9 +24,10 @@
 //   - Pose graph: one variable per frame of a and b (T_world_frame) and one for C; a's first
 //     frame is the gauge. Factors: every window's BA (information from its Hessian), every
 //     cross link (Huber), each boundary between two top-layer submaps (no window spans it:
-//     without a factor each top submap would float on its own, held only by the damping):
-//     the two submaps registered to each other (boundary_links.hpp), or where that fails the
-//     odometry's step across it, and for every b frame an extrinsic tie to the a frame nearest its
+//     without a factor each top submap would float on its own, held only by the damping): a
+//     bridge BA over the members on both sides (boundary_bridges.hpp, with boundary_bridges),
+//     else the two submaps registered to each other (boundary_links.hpp), else the odometry's
+//     step across it, and for every b frame an extrinsic tie to the a frame nearest its
 //     instant, with a's motion to that instant taken from the current poses:
 //     r = log((T_a L)^-1 T_b C^-1) (isotropic information, extrinsic_sigma_*). The ties know the
 //     clock offset only through the current estimate, so they are deliberately weak: the
@@ -68,6 +69,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "hots/boundary_bridges.hpp"
 #include "hots/boundary_links.hpp"
 #include "hots/cross_links.hpp"
 #include "hots/hierarchy.hpp"
@@ -93,10 +95,13 @@ struct RefineOptions {
   double extrinsic_sigma_rad = 0.003;  ///< per tie
   double link_huber = 3.0;             ///< whitened units
   /// The hierarchy's top-layer submaps share no BA window, so nothing in the graph would tie
-  /// one to the next. With boundary_registration each submap is registered to the next
+  /// one to the next. With boundary_bridges a window BA over the top layer's members on both
+  /// sides of each boundary ties them (boundary_bridges.hpp). Where there is no usable bridge,
+  /// with boundary_registration each submap is registered to the next
   /// (boundary_links.hpp, Huber link_huber); where that fails, or without it, the odometry's
   /// step across the boundary (last frame of a submap to the first of the next) becomes a
   /// factor with these standard deviations. sigma <= 0 and no registration: no boundary factors.
+  bool boundary_bridges = false;
   bool boundary_registration = true;
   /// m, the boundary registration's crop around the boundary (boundary_links.hpp); 0: none.
   double boundary_radius_m = 0.0;
@@ -149,7 +154,8 @@ struct RefineStatistics {
   std::size_t ba_factors = 0, cross_links = 0, cross_links_attempted = 0, extrinsic_ties = 0;
   std::size_t cross_links_agreeing = 0;  ///< kept links that confirm the start (cross_links.hpp)
   std::size_t boundary_factors = 0;      ///< top-layer submap boundaries tied in the graph
-  std::size_t boundary_links = 0;  ///< of those, by registering the submaps (the rest: odometry)
+  std::size_t boundary_links = 0;    ///< of those, by registering the submaps (the rest: odometry)
+  std::size_t boundary_bridges = 0;  ///< boundaries tied by a bridge BA (not in boundary_factors)
   double graph_initial_cost = 0.0, graph_cost = 0.0;
   int graph_iterations = 0;
   double time_sync_spread = 0.0;
@@ -356,10 +362,14 @@ RefineResult refine(const FramesA& frames_a, const std::vector<double>& times_a,
 
   const auto ha = build_hierarchy(fa, world_a, options.hierarchy, parts > 1 ? &sweeps_a : nullptr);
   const auto hb = build_hierarchy(fb, world_b, options.hierarchy, parts > 1 ? &sweeps_b : nullptr);
+  const auto bridges_a =
+      options.boundary_bridges ? boundary_bridges(ha, fa, options.hierarchy) : BoundaryBridges{};
+  const auto bridges_b =
+      options.boundary_bridges ? boundary_bridges(hb, fb, options.hierarchy) : BoundaryBridges{};
   st.hierarchy_seconds = d::lap(clock);
-  st.windows = ha.windows + hb.windows;
+  st.windows = ha.windows + hb.windows + bridges_a.windows + bridges_b.windows;
   st.failed_windows = ha.failed_windows + hb.failed_windows;
-  st.planes = ha.planes + hb.planes;
+  st.planes = ha.planes + hb.planes + bridges_a.planes + bridges_b.planes;
   world_a = ha.poses;
   world_b = hb.poses;
 
@@ -378,13 +388,13 @@ RefineResult refine(const FramesA& frames_a, const std::vector<double>& times_a,
                 "(statistics: cross_links_agreeing of cross_links_attempted)");
   using BoundaryLinks = std::vector<std::optional<CrossLink>>;
   const BoundaryLinks boundary_a =
-      options.boundary_registration
-          ? boundary_links(ha, fa, world_a, options.links, options.boundary_radius_m)
-          : BoundaryLinks{};
+      options.boundary_registration ? boundary_links(ha, fa, world_a, options.links,
+                                                     options.boundary_radius_m, &bridges_a.bridged)
+                                    : BoundaryLinks{};
   const BoundaryLinks boundary_b =
-      options.boundary_registration
-          ? boundary_links(hb, fb, world_b, options.links, options.boundary_radius_m)
-          : BoundaryLinks{};
+      options.boundary_registration ? boundary_links(hb, fb, world_b, options.links,
+                                                     options.boundary_radius_m, &bridges_b.bridged)
+                                    : BoundaryLinks{};
   st.links_seconds = d::lap(clock);
 
   const std::size_t na = frames_a.size(), nb = frames_b.size();
@@ -403,19 +413,27 @@ RefineResult refine(const FramesA& frames_a, const std::vector<double>& times_a,
     f.kind = kind;
     graph.add_factor(f);
   };
-  for (const auto& f : ha.factors) add_relative(f.from, f.to, f.measured, f.information, 0.0, 0);
-  for (const auto& f : hb.factors)
-    add_relative(na + f.from, na + f.to, f.measured, f.information, 0.0, 0);
-  st.ba_factors = ha.factors.size() + hb.factors.size();
+  for (const auto* list : {&ha.factors, &bridges_a.factors})
+    for (const auto& f : *list) add_relative(f.from, f.to, f.measured, f.information, 0.0, 0);
+  for (const auto* list : {&hb.factors, &bridges_b.factors})
+    for (const auto& f : *list)
+      add_relative(na + f.from, na + f.to, f.measured, f.information, 0.0, 0);
+  st.ba_factors =
+      ha.factors.size() + hb.factors.size() + bridges_a.factors.size() + bridges_b.factors.size();
   for (const auto& l : links)
     add_relative(l.frame_a, na + l.frame_b, l.measured, l.information, options.link_huber, 1);
   const bool odometry_boundaries =
       options.boundary_sigma_m > 0.0 && options.boundary_sigma_rad > 0.0;
-  auto add_boundaries = [&](const auto& hierarchy, const BoundaryLinks& registered,
+  auto add_boundaries = [&](const auto& hierarchy, const BoundaryBridges& bridges,
+                            const BoundaryLinks& registered,
                             const std::vector<Isometry3d>& odometry, std::size_t first_var) {
     if (hierarchy.members.empty()) return;
     const auto& top = hierarchy.members.back();
     for (std::size_t m = 0; m + 1 < top.size(); ++m) {
+      if (m < bridges.bridged.size() && bridges.bridged[m]) {
+        ++st.boundary_bridges;  // its factors are among the BA's
+        continue;
+      }
       if (m < registered.size() && registered[m]) {
         const CrossLink& l = *registered[m];
         add_relative(first_var + l.frame_a, first_var + l.frame_b, l.measured, l.information,
@@ -433,8 +451,8 @@ RefineResult refine(const FramesA& frames_a, const std::vector<double>& times_a,
       ++st.boundary_factors;
     }
   };
-  add_boundaries(ha, boundary_a, poses_a, 0);
-  add_boundaries(hb, boundary_b, poses_b, na);
+  add_boundaries(ha, bridges_a, boundary_a, poses_a, 0);
+  add_boundaries(hb, bridges_b, boundary_b, poses_b, na);
   const std::size_t first_tie = graph.factors.size();
   const Mat6d tie_sqrt =
       isotropic_sqrt_information(options.extrinsic_sigma_m, options.extrinsic_sigma_rad);

@@ -1,12 +1,15 @@
 // Hierarchy of one LiDAR: frames of a synthetic room with drifting poses come out closer to
-// the truth, factors tie window anchors at every layer, the same bits on 1 and 2 threads.
+// the truth, factors tie window anchors at every layer, bridges tie the top layer's submaps,
+// the same bits on 1 and 2 threads.
 #include <tbb/task_arena.h>
 #include <catch2/catch.hpp>
 #include <random>
 #include <vector>
 
+#include "hots/boundary_bridges.hpp"
 #include "hots/hierarchy.hpp"
 #include "hots_test_util.hpp"
+#include "ulc/core/pose_error.hpp"
 
 using namespace hots;
 using namespace hots_test;
@@ -91,4 +94,63 @@ TEST_CASE("the hierarchy gives the same bits on 1 and 2 threads", "[hots][hierar
     CHECK(one.poses[k].matrix() == two.poses[k].matrix());
   for (std::size_t k = 0; k < one.factors.size(); ++k)
     CHECK(one.factors[k].information == two.factors[k].information);
+  options.layers = 1;  // three top submaps: two bridges
+  BoundaryBridges bridges_one, bridges_two;
+  tbb::task_arena(1).execute([&] {
+    bridges_one = boundary_bridges(build_hierarchy(s.frames, s.start, options), s.frames, options);
+  });
+  tbb::task_arena(2).execute([&] {
+    bridges_two = boundary_bridges(build_hierarchy(s.frames, s.start, options), s.frames, options);
+  });
+  REQUIRE(bridges_one.factors.size() == 2 * 2);
+  REQUIRE(bridges_two.factors.size() == bridges_one.factors.size());
+  for (std::size_t k = 0; k < bridges_one.factors.size(); ++k) {
+    CHECK(bridges_one.factors[k].measured.matrix() == bridges_two.factors[k].measured.matrix());
+    CHECK(bridges_one.factors[k].information == bridges_two.factors[k].information);
+  }
+}
+
+TEST_CASE("bridges tie the top layer's submaps across their boundaries", "[hots][hierarchy]") {
+  // One layer of windows of 3 over 12 frames: top submaps [0,3) [3,6) [6,9) [9,12), tied to
+  // each other only by the start's (drifting) steps. A bridge over frames [b-1, b+2) measures
+  // the step across boundary b from both sides' points.
+  const Scene& s = scene();
+  HierarchyOptions options;
+  options.window = 3;
+  options.layers = 1;
+  const auto h = build_hierarchy(s.frames, s.start, options);
+  REQUIRE(h.members.size() == 2);
+  REQUIRE(h.members.back().size() == 4);
+  const BoundaryBridges bridges = boundary_bridges(h, s.frames, options);
+  CHECK(bridges.windows == 3);
+  CHECK(bridges.planes > 0);
+  REQUIRE(bridges.bridged.size() == 3);
+  for (const bool b : bridges.bridged) CHECK(b);
+  REQUIRE(bridges.factors.size() == 3 * 2);  // to the far side's two frames
+  for (std::size_t k = 0; k < bridges.factors.size(); ++k) {
+    const HierarchyFactor& f = bridges.factors[k];
+    const std::size_t boundary = 3 * (k / 2 + 1);
+    CHECK(f.from == boundary - 1);
+    CHECK(f.to == boundary + k % 2);
+    const Eigen::SelfAdjointEigenSolver<Mat6d> eig(f.information);
+    CHECK(eig.eigenvalues()(0) > 0.0);
+    const Isometry3d truth = s.truth[f.from].inverse() * s.truth[f.to];
+    const auto before = ulc::pose_error(truth, h.poses[f.from].inverse() * h.poses[f.to]);
+    const auto after = ulc::pose_error(truth, f.measured);
+    INFO("factor " << f.from << " -> " << f.to << ": " << 100 * before.translation_m << " cm "
+                   << before.rotation_deg << " deg -> " << 100 * after.translation_m << " cm "
+                   << after.rotation_deg << " deg");
+    CHECK(before.translation_m > 0.01);
+    CHECK(after.translation_m < 0.2 * before.translation_m);
+    CHECK(after.rotation_deg < 0.2 * before.rotation_deg);
+  }
+  // A single top submap has no boundary; a bridge never runs.
+  HierarchyOptions tall = options;
+  tall.layers = 3;
+  const auto one_top = build_hierarchy(s.frames, s.start, tall);
+  REQUIRE(one_top.members.back().size() == 1);
+  const BoundaryBridges none = boundary_bridges(one_top, s.frames, tall);
+  CHECK(none.bridged.empty());
+  CHECK(none.factors.empty());
+  CHECK(none.windows == 0);
 }

@@ -123,13 +123,14 @@ TEST_CASE("refine with continuous-time sweeps in the layer-0 BA", "[hots][refine
 namespace {
 
 /// refine() with one BA layer over the 3 s drive: six 5-frame submaps per LiDAR that no window
-/// spans, so only the boundary factors tie each to the next.
+/// spans, so only the boundary factors (or bridges) tie each to the next.
 hots::RefineResult one_layer(const std::vector<ulc::Isometry3d>& pa,
                              const std::vector<ulc::Isometry3d>& pb, bool registration,
-                             double odometry_sigma_m) {
+                             double odometry_sigma_m, bool bridges = false) {
   const Drive& d = drive();
   hots::RefineOptions options;
   options.hierarchy.layers = 1;
+  options.boundary_bridges = bridges;
   options.synchronise_time = false;  // the clocks agree; 3 s could not show it anyway
   options.boundary_registration = registration;
   options.boundary_sigma_m = odometry_sigma_m;
@@ -236,10 +237,12 @@ TEST_CASE("the top layer's submaps are tied together", "[hots][refine]") {
   const auto registered = one_layer(pa, pb, true, 0.02);
   const auto stepped = one_layer(pa, pb, false, 0.02);
   const auto loose = one_layer(pa, pb, false, 0.0);
+  const auto bridged = one_layer(pa, pb, false, 0.0, true);
   INFO(hots::to_string(registered.status) << ": " << registered.reason);
   REQUIRE(registered.ok());
   REQUIRE(stepped.ok());
   REQUIRE(loose.ok());
+  REQUIRE(bridged.ok());
   const std::size_t submaps_a = (a.frames.size() + 4) / 5, submaps_b = (b.frames.size() + 4) / 5;
   const std::size_t boundaries = submaps_a - 1 + submaps_b - 1;
   CHECK(registered.statistics.boundary_factors == boundaries);
@@ -247,16 +250,24 @@ TEST_CASE("the top layer's submaps are tied together", "[hots][refine]") {
   CHECK(stepped.statistics.boundary_factors == boundaries);
   CHECK(stepped.statistics.boundary_links == 0);
   CHECK(loose.statistics.boundary_factors == 0);
+  CHECK(loose.statistics.boundary_bridges == 0);
+  CHECK(bridged.statistics.boundary_bridges == boundaries);
+  CHECK(bridged.statistics.boundary_factors == 0);  // a bridge's factors are the BA's
+  CHECK(bridged.statistics.ba_factors > loose.statistics.ba_factors);
   const double odometry = ate(d.truth_a, pa);
   const double with_links = ate(d.truth_a, registered.poses_a);
   const double with_steps = ate(d.truth_a, stepped.poses_a);
   const double without = ate(d.truth_a, loose.poses_a);
+  const double with_bridges = ate(d.truth_a, bridged.poses_a);
   INFO("ATE of a: odometry " << odometry << ", registered boundaries " << with_links
-                             << ", odometry steps " << with_steps << ", none " << without);
+                             << ", odometry steps " << with_steps << ", bridges " << with_bridges
+                             << ", none " << without);
   CHECK(with_links < odometry);
   CHECK(with_steps < odometry);
+  CHECK(with_bridges < odometry);
   CHECK(with_links < 0.5 * without);
   CHECK(with_steps < 0.5 * without);
+  CHECK(with_bridges < 0.5 * without);
 }
 
 TEST_CASE("an odometry glitch at a top-layer boundary does not tilt the rest of the drive",
@@ -275,20 +286,28 @@ TEST_CASE("an odometry glitch at a top-layer boundary does not tilt the rest of 
   const auto pb = glitched(drifting(d.truth_b, b.timestamps, 2), k, 1.0, 0.05);
   const auto registered = one_layer(pa, pb, true, 0.02);
   const auto stepped = one_layer(pa, pb, false, 0.02);
+  const auto bridged = one_layer(pa, pb, false, 0.02, true);
   REQUIRE(registered.ok());
   REQUIRE(stepped.ok());
+  REQUIRE(bridged.ok());
   CHECK(registered.statistics.boundary_links == registered.statistics.boundary_factors);
+  CHECK(bridged.statistics.boundary_factors == 0);  // every boundary bridged: no odometry step
   const double with_links = ate(d.truth_a, registered.poses_a);
   const double with_steps = ate(d.truth_a, stepped.poses_a);
+  const double with_bridges = ate(d.truth_a, bridged.poses_a);
   auto tilt_deg = [&](const std::vector<ulc::Isometry3d>& poses) {  // of the last pose
     return ulc::pose_error(d.truth_a.back(), poses.back()).rotation_deg;
   };
   const double tilt_links = tilt_deg(registered.poses_a), tilt_steps = tilt_deg(stepped.poses_a);
-  INFO("ATE of a: registered boundaries " << with_links << ", odometry steps " << with_steps
-                                          << "; last pose's rotation error " << tilt_links
-                                          << " deg, " << tilt_steps << " deg");
+  const double tilt_bridges = tilt_deg(bridged.poses_a);
+  INFO("ATE of a: registered boundaries "
+       << with_links << ", odometry steps " << with_steps << ", bridges " << with_bridges
+       << "; last pose's rotation error " << tilt_links << " deg, " << tilt_steps << " deg, "
+       << tilt_bridges << " deg");
   CHECK(with_links < 0.5 * with_steps);
   CHECK(tilt_links < 0.5 * tilt_steps);
+  CHECK(with_bridges < 0.5 * with_steps);
+  CHECK(tilt_bridges < 0.5 * tilt_steps);
 }
 
 TEST_CASE("refine reports unusable input", "[hots][refine]") {

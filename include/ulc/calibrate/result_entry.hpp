@@ -158,6 +158,7 @@ inline io::Json hots_to_json(const HotsReport& h) {
   j["extrinsic_ties"] = s.extrinsic_ties;
   j["boundary_factors"] = s.boundary_factors;
   j["boundary_links"] = s.boundary_links;
+  j["boundary_bridges"] = s.boundary_bridges;
   j["graph_iterations"] = s.graph_iterations;
   j["graph_initial_cost"] = s.graph_initial_cost;
   j["graph_cost"] = s.graph_cost;
