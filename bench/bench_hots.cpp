@@ -112,6 +112,7 @@ void apply_hots_setting(hots::RefineOptions& o, const std::string& setting) {
       {"frame_voxel", [&] { o.frame_voxel = v; }},
       {"submap_voxel", [&] { o.hierarchy.submap_voxel = v; }},
       {"boundary_bridges", [&] { o.boundary_bridges = v != 0.0; }},
+      {"bridge_huber", [&] { o.bridge_huber = v; }},
       {"boundary_registration", [&] { o.boundary_registration = v != 0.0; }},
       {"boundary_radius_m", [&] { o.boundary_radius_m = v; }},
       {"boundary_sigma_m", [&] { o.boundary_sigma_m = v; }},

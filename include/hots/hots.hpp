@@ -102,6 +102,7 @@ struct RefineOptions {
   /// step across the boundary (last frame of a submap to the first of the next) becomes a
   /// factor with these standard deviations. sigma <= 0 and no registration: no boundary factors.
   bool boundary_bridges = false;
+  double bridge_huber = 0.0;  ///< whitened units; 0: a bridge's factors are plain least squares
   bool boundary_registration = true;
   /// m, the boundary registration's crop around the boundary (boundary_links.hpp); 0: none.
   double boundary_radius_m = 0.0;
@@ -413,11 +414,13 @@ RefineResult refine(const FramesA& frames_a, const std::vector<double>& times_a,
     f.kind = kind;
     graph.add_factor(f);
   };
-  for (const auto* list : {&ha.factors, &bridges_a.factors})
-    for (const auto& f : *list) add_relative(f.from, f.to, f.measured, f.information, 0.0, 0);
-  for (const auto* list : {&hb.factors, &bridges_b.factors})
-    for (const auto& f : *list)
-      add_relative(na + f.from, na + f.to, f.measured, f.information, 0.0, 0);
+  for (const auto& f : ha.factors) add_relative(f.from, f.to, f.measured, f.information, 0.0, 0);
+  for (const auto& f : hb.factors)
+    add_relative(na + f.from, na + f.to, f.measured, f.information, 0.0, 0);
+  for (const auto& f : bridges_a.factors)
+    add_relative(f.from, f.to, f.measured, f.information, options.bridge_huber, 0);
+  for (const auto& f : bridges_b.factors)
+    add_relative(na + f.from, na + f.to, f.measured, f.information, options.bridge_huber, 0);
   st.ba_factors =
       ha.factors.size() + hb.factors.size() + bridges_a.factors.size() + bridges_b.factors.size();
   for (const auto& l : links)
