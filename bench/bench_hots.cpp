@@ -3,7 +3,7 @@
 //
 //   bench_hots --accuracy    [--scenarios 64-32,...] [--seconds 60] [--runs 10]
 //   bench_hots --time-offset [--scenarios 64-32,64-horizon] [--seconds 60] [--runs 10]
-//                            [--spread-png PREFIX]
+//                            [--spread-png PREFIX] [--offset-ms 50]
 //   common: [--decimation 1] [--threads 2] [--deskew-from-base] [--jeep-decides]
 //           [--first-run 0] [--json]
 //           [--layers N] [--trajectory PREFIX] [--hots NAME=VALUE ...] [--steering-ramp M]
@@ -33,7 +33,8 @@
 // by hand (the same odometry and refine options as ulc::CalibrateOptions' defaults) so that the
 // poses are at hand for the trajectory error. Success: HOTS ok and e_rot < 1 deg and e_trans < 10
 // cm. Medians are over all runs, failures included. --time-offset runs each scenario with the
-// target's clock 50 ms behind (the paper's figure) and with no offset. --spread-png PREFIX
+// target's clock 50 ms behind (the paper's figure) and with no offset (--offset-ms X: only X
+// ms; the no-offset runs are the same as --accuracy's). --spread-png PREFIX
 // writes run 0's spread-against-offset curve (HOTS's last time synchronisation pass) of each
 // scenario and offset to PREFIX_<scenario>_<offset_ms>ms.png: x the candidate offset in ms,
 // y the corrected spread in cm^2, a solid green line at the true offset and a dashed red one at
@@ -93,7 +94,8 @@ struct Config {
   double steering_ramp_m = 0.0;   ///< --steering-ramp M: MotionSpec::steering_ramp_m
   int layers = 0;                 ///< --layers: HOTS hierarchy layers; 0: the default
   std::string trajectory;         ///< --trajectory PREFIX: per-frame poses of each run, as CSV
-  std::vector<std::string> hots_settings;  ///< --hots NAME=VALUE, applied in order
+  std::vector<std::string> hots_settings;       ///< --hots NAME=VALUE, applied in order
+  std::vector<double> offsets_s = {0.05, 0.0};  ///< --time-offset's offsets (--offset-ms X: X)
   ulc_bench::Options bench;
 };
 
@@ -383,8 +385,7 @@ void bench(Config c) {
     c.scenarios = offsets ? std::vector<std::string>{"64-32", "64-horizon"}
                           : std::vector<std::string>{"64-32",      "32-16",   "horizon-tele",
                                                      "64-horizon", "32-avia", "64-tele"};
-  const std::vector<double> offset_list =
-      offsets ? std::vector<double>{0.05, 0.0} : std::vector<double>{0.0};
+  const std::vector<double> offset_list = offsets ? c.offsets_s : std::vector<double>{0.0};
   ulc_bench::Table table({"scenario",
                           "offset_ms",
                           "runs",
@@ -520,6 +521,7 @@ int main(int argc, char** argv) {
       .value("--decimation", ulc_bench::at_least(c.decimation, 1u))
       .value("--threads", ulc_bench::at_least(c.threads, 1))
       .value("--spread-png", ulc_bench::text(c.spread_png))
+      .value("--offset-ms", [&](const char* s) { c.offsets_s = {std::atof(s) * 1e-3}; })
       .value("--pre-shift-ms", ulc_bench::number(c.pre_shift_s, 1e-3))
       .value("--layers", ulc_bench::at_least(c.layers, 1))
       .value("--trajectory", ulc_bench::text(c.trajectory))

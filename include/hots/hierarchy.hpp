@@ -71,7 +71,9 @@ struct HierarchyOptions {
   /// to each other directly.
   bool end_knot_factor = false;
   /// Parts per sweep for the continuous-time layer 0 (refine() splits the frames); 1: rigid.
-  int sweep_parts = 1;
+  /// Two by default: on the 60 s 64-32 drives the sweeps lower HOTS's trajectory error
+  /// (docs/BENCHMARKS.md, sessions 19-21) for +0.5 GB (the parts are a second copy of the frames).
+  int sweep_parts = 2;
 };
 
 /// One frame's sweep for a continuous-time layer 0: its points in parts by time, each part's

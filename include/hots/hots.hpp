@@ -101,7 +101,7 @@ struct RefineOptions {
   /// (boundary_links.hpp, Huber link_huber); where that fails, or without it, the odometry's
   /// step across the boundary (last frame of a submap to the first of the next) becomes a
   /// factor with these standard deviations. sigma <= 0 and no registration: no boundary factors.
-  bool boundary_bridges = false;
+  bool boundary_bridges = true;
   double bridge_huber = 0.0;  ///< whitened units; 0: a bridge's factors are plain least squares
   bool boundary_registration = true;
   /// m, the boundary registration's crop around the boundary (boundary_links.hpp); 0: none.

@@ -86,31 +86,35 @@ TEST_CASE("refine improves a disturbed extrinsic on a simulated 64-32 drive", "[
   CHECK(r.covariance_6x6.trace() > 0.0);
 }
 
-TEST_CASE("refine with continuous-time sweeps in the layer-0 BA", "[hots][refine][sweep_ba]") {
-  // The frames split in two parts by time (hierarchy.hpp, sweep_parts), each window's last
-  // sweep ending at the next frame's pose.
+TEST_CASE("refine with rigid frames or continuous-time sweeps in the layer-0 BA",
+          "[hots][refine][sweep_ba]") {
+  // sweep_parts = 1: each frame one rigid cloud at its pose; 2 (the default): the frames split
+  // in two parts by time (hierarchy.hpp), each window's last sweep ending at the next frame's
+  // pose. Both must refine the extrinsic and the poses.
   const Drive& d = drive();
   const auto& a = d.data.lidars[0];
   const auto& b = d.data.lidars[1];
   const auto [C_gt, C0, pa, pb] = disturbed_start();
   hots::RefineOptions options;
-  options.hierarchy.sweep_parts = 2;
   options.synchronise_time = false;  // the clocks agree; 3 s could not show it anyway
-  const hots::RefineResult r =
-      hots::refine(a.frames, a.timestamps, pa, b.frames, b.timestamps, pb, C0, options);
-  INFO(hots::to_string(r.status) << ": " << r.reason);
-  REQUIRE(r.ok());
-  const auto e0 = ulc::pose_error(C_gt, C0);
-  const auto e = ulc::pose_error(C_gt, r.extrinsic);
-  const double before_a = ate(d.truth_a, pa), after_a = ate(d.truth_a, r.poses_a);
-  INFO("extrinsic " << e0.translation_m << " m " << e0.rotation_deg << " deg -> " << e.translation_m
-                    << " m " << e.rotation_deg << " deg; ATE of a " << before_a << " -> " << after_a
-                    << "; windows " << r.statistics.windows << " failed "
-                    << r.statistics.failed_windows);
-  CHECK(r.statistics.failed_windows == 0);
-  CHECK(e.translation_m < 0.5 * e0.translation_m);
-  CHECK(e.rotation_deg < 0.5 * e0.rotation_deg);
-  CHECK(after_a < 0.5 * before_a);
+  hots::RefineResult r;
+  for (const int parts : {1, 2}) {
+    options.hierarchy.sweep_parts = parts;
+    r = hots::refine(a.frames, a.timestamps, pa, b.frames, b.timestamps, pb, C0, options);
+    INFO("parts " << parts << ": " << hots::to_string(r.status) << ": " << r.reason);
+    REQUIRE(r.ok());
+    const auto e0 = ulc::pose_error(C_gt, C0);
+    const auto e = ulc::pose_error(C_gt, r.extrinsic);
+    const double before_a = ate(d.truth_a, pa), after_a = ate(d.truth_a, r.poses_a);
+    INFO("extrinsic " << e0.translation_m << " m " << e0.rotation_deg << " deg -> "
+                      << e.translation_m << " m " << e.rotation_deg << " deg; ATE of a " << before_a
+                      << " -> " << after_a << "; windows " << r.statistics.windows << " failed "
+                      << r.statistics.failed_windows);
+    CHECK(r.statistics.failed_windows == 0);
+    CHECK(e.translation_m < 0.5 * e0.translation_m);
+    CHECK(e.rotation_deg < 0.5 * e0.rotation_deg);
+    CHECK(after_a < 0.5 * before_a);
+  }
   // With end_knot_factor, every layer-0 window but each LiDAR's last adds its end knot's factor.
   options.hierarchy.end_knot_factor = true;
   const hots::RefineResult rf =
@@ -184,10 +188,15 @@ TEST_CASE("an extrinsic the LiDARs' views do not confirm is refused", "[hots][re
   const hots::RefineResult unchecked =
       hots::refine(a.frames, a.timestamps, pa, b.frames, b.timestamps, pb, wrong, options);
   CHECK(unchecked.status != hots::RefineStatus::extrinsic_unconfirmed);
-  // ... and what it would have returned misses issue 7's bar (0.1 deg, 2 cm) by far.
+  // ... and the graph, with no link to hold the extrinsic, misses issue 7's bar (0.1 deg, 2 cm)
+  // by far. (The whole-sequence step after it may still find the truth from there: on this
+  // drive it does with two sweep parts, 0.003 deg / 0.2 cm, not with rigid frames, 0.27 deg /
+  // 2 m; nothing in the run tells which, so the refusal stands.)
+  const auto eg = ulc::pose_error(C_gt, unchecked.statistics.graph_extrinsic);
   const auto e = ulc::pose_error(C_gt, unchecked.extrinsic);
-  INFO("unchecked: " << e.rotation_deg << " deg " << 100 * e.translation_m << " cm");
-  CHECK((e.rotation_deg > 0.2 || e.translation_m > 0.04));
+  INFO("unchecked: graph " << eg.rotation_deg << " deg " << 100 * eg.translation_m << " cm, final "
+                           << e.rotation_deg << " deg " << 100 * e.translation_m << " cm");
+  CHECK((eg.rotation_deg > 0.2 || eg.translation_m > 0.04));
 }
 
 TEST_CASE("a link records how far its registration moved from the start", "[hots][links]") {
