@@ -13,7 +13,7 @@ ulc=./build/apps/ulc/ulc
 # The whole calibration on a user's own point struct, checked against the simulator's truth.
 ./build/examples/example_calibrate_own_points
 out=${ULC_OUT:-/tmp/ulc_demo}
-$ulc simulate --scenario 64-horizon --seconds 20 --seed 1 --out "$out/64-horizon" \
+$ulc simulate --scenario 64-horizon --seconds 30 --seed 1 --out "$out/64-horizon" \
   --preview "$out/64-horizon_preview.png"
 $ulc inspect "$out/64-horizon/lidar64"
 $ulc inspect "$out/64-horizon/horizon"
