@@ -8,6 +8,10 @@ install(DIRECTORY ${PROJECT_SOURCE_DIR}/include/ DESTINATION ${CMAKE_INSTALL_INC
         FILES_MATCHING PATTERN "*.hpp")
 install(TARGETS ulc EXPORT ulcTargets)
 install(EXPORT ulcTargets NAMESPACE ulc:: DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/ulc)
+# The recording readers are a component of their own, so that find_package(ulc) alone needs only
+# the three core dependencies: find_package(ulc CONFIG REQUIRED COMPONENTS bags) -> ulc::bags.
+install(TARGETS ulc_bags EXPORT ulcBagsTargets)
+install(EXPORT ulcBagsTargets NAMESPACE ulc:: DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/ulc)
 
 configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/ulcConfig.cmake.in
                               ${PROJECT_BINARY_DIR}/ulcConfig.cmake

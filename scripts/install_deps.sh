@@ -2,7 +2,9 @@
 # Installs what ULC needs on Debian 12 (run as root). Only Debian packages; nothing downloaded
 # from elsewhere. Safe to run again.
 set -euo pipefail
-packages=(g++ cmake ninja-build libeigen3-dev libtbb-dev libnanoflann-dev catch2 libstb-dev)
+packages=(g++ cmake ninja-build libeigen3-dev libtbb-dev libnanoflann-dev catch2 libstb-dev
+  pkg-config libbz2-dev liblz4-dev libzstd-dev libsqlite3-dev
+  libyaml-cpp-dev)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -16,3 +16,4 @@ run(${CMAKE_COMMAND} -S ${ULC_SOURCE_DIR}/tests/package_consumer -B ${WORK_DIR}/
     -G ${GENERATOR} -DCMAKE_PREFIX_PATH=${prefix} -DCMAKE_BUILD_TYPE=Release)
 run(${CMAKE_COMMAND} --build ${WORK_DIR}/consumer-build)
 run(${WORK_DIR}/consumer-build/consumer)
+run(${WORK_DIR}/consumer-build/consumer_bags)

@@ -19,6 +19,13 @@ inline std::filesystem::path croon_dir() {
   return std::filesystem::exists(dir / "top.pcd") ? dir : std::filesystem::path();
 }
 
+/// The real bags of other people's tools (../shared/data/bags, its README says what each holds),
+/// or an empty path when ../shared is not beside the checkout.
+inline std::filesystem::path bags_dir() {
+  auto dir = shared_dir() / "data" / "bags";
+  return std::filesystem::exists(dir / "README.md") ? dir : std::filesystem::path();
+}
+
 }  // namespace ulc_test
 
 /// Skip the rest of a TEST_CASE cleanly when a path is missing (Catch2 v2 has no SKIP).
