@@ -17,13 +17,13 @@
 #include "commands.hpp"
 #include "fused_cloud.hpp"
 #include "initial_extrinsic.hpp"
+#include "lidar_input.hpp"
 #include "progress.hpp"
 #include "ulc/calibrate.hpp"
 #include "ulc/calibrate/result_entry.hpp"
 #include "ulc/calibrate/rig.hpp"
 #include "ulc/io/result_file.hpp"
 #include "ulc/io/result_yaml.hpp"
-#include "ulc/io/sequence.hpp"
 
 namespace ulc::app {
 namespace {
@@ -147,8 +147,11 @@ void print_cycle(const io::CycleResult& c) {
 
 int run_calibrate(int argc, char** argv) {
   cli::Args args("calibrate");
-  args.option("base", "PATH", "the base LiDAR: a frame folder or one frame file", true)
-      .option("target", "PATH", "a target LiDAR: a frame folder or one frame file", true, true)
+  args.option("base", "SOURCE",
+              "the base LiDAR: a frame folder, a cloud file, or FILE:TOPIC of a recording (.bag, "
+              ".mcap, rosbag2 folder, .db3); add =NAME to name it",
+              true)
+      .option("target", "SOURCE", "a target LiDAR, as --base", true, true)
       .option("output", "FILE", "write the result file (DESIGN.md) here")
       .option("format", "json|yaml",
               "format of --output (default json; yaml adds ROS and URDF forms of each extrinsic)")
@@ -161,8 +164,9 @@ int run_calibrate(int argc, char** argv) {
               "the stages skip terra")
       .option("frame-index", "N", "TERRA's frame, and the first frame of JEEP and HOTS (default 0)")
       .option("frames", "K", "frame pairs JEEP uses (default 5)")
-      .option("threads", "N", "worker threads (default: all cores)")
-      .flag("synced-clocks",
+      .option("threads", "N", "worker threads (default: all cores)");
+  add_input_options(args);
+  args.flag("synced-clocks",
             "the LiDARs' clocks are synchronised (PTP, GPS): HOTS estimates no clock offset "
             "(for short drives that cannot pin one down)")
       .flag("no-route",
@@ -220,40 +224,34 @@ int run_calibrate(int argc, char** argv) {
   for (const char* file_option : {"output", "merged-cloud", "report"})
     if (args.has(file_option)) require_output_folder(args.get(file_option));
 
-  const io::Sequence base(args.get("base"));
-  std::vector<io::Sequence> targets;
-  for (const auto& path : args.get_all("target")) targets.emplace_back(path);
-  require_frame(base, frame_index);
-  for (const auto& t : targets) require_frame(t, frame_index);
-  for (std::size_t k = 0; k < targets.size(); ++k) {  // the result file keys on the names
-    const std::string& name = targets[k].name();
-    bool repeated = name == base.name();
-    for (std::size_t m = 0; m < k; ++m) repeated = repeated || targets[m].name() == name;
-    if (repeated)
-      throw cli::UsageError("calibrate: two LiDARs are named '" + name + "' (" +
-                            targets[k].path().string() + "); give each its own folder name");
-  }
+  std::vector<LidarSpec> specs{parse_lidar_spec(args.get("base"), "calibrate", "base")};
+  for (const auto& t : args.get_all("target"))
+    specs.push_back(parse_lidar_spec(t, "calibrate", "target"));
+  const auto inputs = open_lidar_inputs(specs, input_options(args, "calibrate"), "calibrate");
+  print_input_warnings(inputs, "calibrate");
+  const LidarInput& base = *inputs.front();
 
   // The frames each stage needs, counted from frame_index; the base's are shared by all targets.
-  // HOTS needs them all.
-  const std::size_t base_count = run_hots   ? base.size() - frame_index
-                                 : run_jeep ? options.jeep.frames
-                                            : 1;
+  const std::size_t base_count = run_hots ? kAllFrames : run_jeep ? options.jeep.frames : 1;
   const bool quiet = args.has("quiet");
-  const LoadedFrames base_frames = load_frames(base, frame_index, base_count);
+  const LoadedFrames base_frames = base.load(frame_index, base_count);
+  require_frame(base, base_frames, frame_index);
 
   // Every LiDAR's frames are held for the whole rig: routes and cycles pair targets too.
   std::vector<LoadedFrames> target_frames;
-  for (const auto& target : targets) {
-    const std::size_t count = run_hots   ? target.size() - frame_index
-                              : run_jeep ? covering_count(base, target, base_count)
-                                         : 1;
-    target_frames.push_back(load_frames(target, frame_index, count));
+  for (std::size_t k = 1; k < inputs.size(); ++k) {
+    const std::size_t count = run_hots ? kAllFrames
+                              : run_jeep
+                                  ? covering_count(base.period(), inputs[k]->period(), base_count)
+                                  : 1;
+    target_frames.push_back(inputs[k]->load(frame_index, count));
+    require_frame(*inputs[k], target_frames.back(), frame_index);
   }
   using Frames = std::vector<PointCloud<float>>;
   std::vector<RigLidar<Frames>> lidars{{base.name(), &base_frames.clouds, &base_frames.times, {}}};
-  for (std::size_t k = 0; k < targets.size(); ++k) {
-    RigLidar<Frames> l{targets[k].name(), &target_frames[k].clouds, &target_frames[k].times, {}};
+  for (std::size_t k = 0; k + 1 < inputs.size(); ++k) {
+    RigLidar<Frames> l{
+        inputs[k + 1]->name(), &target_frames[k].clouds, &target_frames[k].times, {}};
     if (!run_terra) l.initial = parse_initial(args.get("initial"), base.name(), l.name);
     lidars.push_back(std::move(l));
   }
@@ -261,7 +259,7 @@ int run_calibrate(int argc, char** argv) {
   rig_options.pair = options;
   rig_options.pair.frame_index = 0;  // the loaded frames start at frame_index
   rig_options.route = !args.has("no-route");
-  rig_options.cycles = !args.has("no-cycles") && targets.size() >= 2;
+  rig_options.cycles = !args.has("no-cycles") && inputs.size() >= 3;
   rig_options.cycle_stages = cycle_stages(options.stages);
   StageProgress progress(quiet);
   rig_options.pair.progress = [&progress](const std::string& stage, double f) {

@@ -18,5 +18,6 @@ int run_calibrate(int argc, char** argv);
 int run_inspect(int argc, char** argv);
 int run_evaluate(int argc, char** argv);
 int run_simulate(int argc, char** argv);
+int run_export(int argc, char** argv);
 
 }  // namespace ulc::app

@@ -17,7 +17,10 @@ constexpr ulc::app::Command kCommands[] = {
      ulc::app::run_calibrate},
     {"simulate", "write a simulated multi-LiDAR dataset with exact ground truth",
      ulc::app::run_simulate},
-    {"inspect", "print what a cloud file or a frame folder holds", ulc::app::run_inspect},
+    {"inspect", "print what a cloud file, a frame folder or a recording (bag) holds",
+     ulc::app::run_inspect},
+    {"export", "write LiDARs of a recording (bag) as a dataset folder of PCD frames",
+     ulc::app::run_export},
     {"evaluate", "compare a result file with ground truth (e_rot, e_trans, time offset)",
      ulc::app::run_evaluate},
 };

@@ -170,6 +170,7 @@ TEST_CASE("ulc calibrate: two LiDARs with one name are bad usage", "[app][calibr
                                " --target " + d.lidar("bpearl_left"));
   INFO(run.output);
   CHECK(run.exit_code == 2);
-  CHECK_THAT(run.output, Catch::Contains("two LiDARs are named 'bpearl_left'"));
+  CHECK_THAT(run.output,
+             Catch::Contains("two LiDARs are named '") && Catch::Contains("bpearl_left'"));
   CHECK(std::count(run.output.begin(), run.output.end(), '\n') == 1);
 }

@@ -1,0 +1,295 @@
+// The LiDAR inputs of the command line: frame folders and files (io::Sequence) and topics of
+// recordings (ulc/bags), behind one interface (lidar_input.hpp).
+#include "lidar_input.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <set>
+
+#include "cli_args.hpp"
+#include "jeep/frame_pairing.hpp"
+#include "ulc/bags/cloud_topic.hpp"
+#include "ulc/bags/recording.hpp"
+#include "ulc/io/decoded_cloud.hpp"
+#include "ulc/io/sequence.hpp"
+
+namespace ulc::app {
+namespace {
+
+namespace fs = std::filesystem;
+
+bool exists(const std::string& path) {
+  std::error_code ec;
+  return !path.empty() && fs::exists(path, ec);
+}
+
+/// Seconds of `window` as [begin, end) after `origin` (same unit as origin: seconds).
+struct SecondsRange {
+  double begin = -std::numeric_limits<double>::infinity();
+  double end = std::numeric_limits<double>::infinity();
+  bool contains(double t) const { return t >= begin && t < end; }
+};
+
+SecondsRange range_after(double origin, const InputWindow& w) {
+  SecondsRange r;
+  const double start = w.start_s.value_or(0.0);
+  if (w.start_s) r.begin = origin + start;
+  if (w.duration_s) r.end = origin + start + *w.duration_s;
+  return r;
+}
+
+class FolderInput : public LidarInput {
+ public:
+  FolderInput(const std::string& path, const InputWindow& window) : seq_(path) {
+    const SecondsRange r = range_after(seq_.frame(0).timestamp, window);
+    for (std::size_t i = 0; i < seq_.size(); ++i)
+      if (r.contains(seq_.frame(i).timestamp)) selected_.push_back(i);
+    if (selected_.empty())
+      throw io::IoError(path, "", "no frame inside the --start / --duration window");
+    name_ = seq_.name();
+  }
+
+  std::string source() const override { return seq_.path().string(); }
+  const io::Sequence& sequence() const { return seq_; }
+
+  void visit(std::size_t first, std::size_t count, const FrameVisitor& fn) const override {
+    const std::size_t end = first + std::min(count, selected_.size());
+    for (std::size_t k = first; k < std::min(end, selected_.size()); ++k) {
+      auto frame = seq_.load_frame<PointCloud<float>>(selected_[k]);
+      if (!fn(std::move(frame.cloud), frame.timestamp)) return;
+    }
+  }
+
+  double period() const override {
+    std::vector<double> t;
+    for (const std::size_t i : selected_) t.push_back(seq_.frame(i).timestamp);
+    return jeep::frame_period(t);
+  }
+
+ private:
+  io::Sequence seq_;
+  std::vector<std::size_t> selected_;
+};
+
+/// One recording, opened once for every LiDAR that reads from it.
+struct Recording {
+  std::string path;
+  std::unique_ptr<bags::MessageSource> source;
+
+  /// Receive time of the recording's first message (ns), 0 when it has none.
+  std::int64_t first_message_ns() const {
+    std::int64_t first = std::numeric_limits<std::int64_t>::max();
+    for (const auto& t : source->topics())
+      if (t.message_count > 0) first = std::min(first, t.first_time_ns);
+    return first == std::numeric_limits<std::int64_t>::max() ? 0 : first;
+  }
+};
+
+bags::TimeWindow receive_window(const Recording& rec, const InputWindow& w) {
+  bags::TimeWindow out;
+  const double origin = static_cast<double>(rec.first_message_ns());
+  if (w.start_s) out.begin_ns = static_cast<std::int64_t>(origin + *w.start_s * 1e9);
+  if (w.duration_s)
+    out.end_ns =
+        static_cast<std::int64_t>(origin + (w.start_s.value_or(0.0) + *w.duration_s) * 1e9);
+  return out;
+}
+
+/// The topic a spec names, or the recording's only point-cloud topic when it names none.
+std::string topic_of(const LidarSpec& spec, const Recording& rec, const std::string& command) {
+  if (!spec.topic.empty()) return spec.topic;
+  const auto clouds = bags::cloud_topics(*rec.source);
+  if (clouds.size() == 1) return clouds.front().name;
+  throw cli::UsageError(
+      command + ": '" + spec.text + "': name the LiDAR's topic as " + spec.path +
+      ":TOPIC; its point-cloud topics: " + bags::describe_cloud_topics(*rec.source));
+}
+
+class TopicInput : public LidarInput {
+ public:
+  TopicInput(std::shared_ptr<Recording> rec, const std::string& topic, const InputOptions& options)
+      : rec_(std::move(rec)),
+        topic_(*rec_->source, topic, rec_->path,
+               options.frame_time == FrameTimeChoice::receive_time ? bags::FrameTime::receive_time
+                                                                   : bags::FrameTime::header_stamp),
+        window_(receive_window(*rec_, options.window)) {
+    bags::TopicFrame first;
+    auto frames = topic_.frames(window_);
+    if (!frames.next(first))
+      throw io::IoError(rec_->path, "",
+                        "topic '" + topic + "' has no message" +
+                            (options.window.start_s || options.window.duration_s
+                                 ? " inside the --start / --duration window"
+                                 : ""));
+    frame_id_ = first.message.header.frame_id;
+    name_ = frame_id_.empty() ? topic : frame_id_;
+  }
+
+  std::string source() const override { return rec_->path + ":" + topic_.info().name; }
+  const std::string& frame_id() const { return frame_id_; }
+  const std::string& topic() const { return topic_.info().name; }
+
+  void visit(std::size_t first, std::size_t count, const FrameVisitor& fn) const override {
+    auto frames = topic_.frames(window_);
+    bags::TopicFrame f;
+    double previous = -std::numeric_limits<double>::infinity();
+    for (std::size_t k = 0; (k < first || k - first < count) && frames.next(f); ++k) {
+      if (!(f.timestamp > previous))
+        throw io::IoError(source(), "",
+                          "frame " + std::to_string(k) + "'s time " + std::to_string(f.timestamp) +
+                              " s does not come after the previous frame's " +
+                              std::to_string(previous) +
+                              " s (a driver that leaves header.stamp unset? try --frame-time "
+                              "receive)");
+      previous = f.timestamp;
+      if (k < first) continue;
+      if (!fn(io::to_cloud<PointCloud<float>>(f.message.cloud), f.timestamp)) return;
+    }
+  }
+
+  double period() const override {
+    const auto& t = topic_.info();
+    if (t.message_count < 2) return 0.0;
+    return static_cast<double>(t.last_time_ns - t.first_time_ns) * 1e-9 /
+           static_cast<double>(t.message_count - 1);
+  }
+
+  std::vector<std::string> warnings() const override { return rec_->source->warnings(); }
+
+ private:
+  std::shared_ptr<Recording> rec_;
+  bags::CloudTopic topic_;
+  bags::TimeWindow window_;
+  std::string frame_id_;
+};
+
+std::unique_ptr<LidarInput> open_one(const LidarSpec& spec, const InputOptions& options,
+                                     std::map<std::string, std::shared_ptr<Recording>>& recordings,
+                                     const std::string& command) {
+  const bool recording = !spec.topic.empty() || bags::is_recording_path(spec.path);
+  if (!recording) return std::make_unique<FolderInput>(spec.path, options.window);
+  auto& rec = recordings[fs::weakly_canonical(spec.path).string()];
+  if (!rec)
+    rec = std::make_shared<Recording>(Recording{spec.path, bags::open_recording(spec.path)});
+  return std::make_unique<TopicInput>(rec, topic_of(spec, *rec, command), options);
+}
+
+/// Parent-folder names for files whose stems repeat; topics for frame_ids that repeat.
+void disambiguate(std::vector<std::unique_ptr<LidarInput>>& inputs,
+                  const std::vector<LidarSpec>& specs) {
+  std::map<std::string, int> seen;
+  for (std::size_t i = 0; i < inputs.size(); ++i)
+    if (specs[i].name.empty()) ++seen[inputs[i]->name()];
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
+    if (!specs[i].name.empty() || seen[inputs[i]->name()] < 2) continue;
+    if (const auto* topic = dynamic_cast<const TopicInput*>(inputs[i].get())) {
+      inputs[i]->set_name(topic->topic());
+      continue;
+    }
+    const fs::path p = fs::path(specs[i].path).lexically_normal();
+    const fs::path parent = (p.filename().empty() ? p.parent_path() : p).parent_path().filename();
+    if (!parent.empty()) inputs[i]->set_name(parent.string() + "/" + inputs[i]->name());
+  }
+}
+
+void require_unique_names(const std::vector<std::unique_ptr<LidarInput>>& inputs,
+                          const std::string& command) {
+  std::set<std::string> names;
+  for (const auto& in : inputs)
+    if (!names.insert(in->name()).second)
+      throw cli::UsageError(command + ": two LiDARs are named '" + in->name() + "' (" +
+                            in->source() + "); name them explicitly: PATH=NAME");
+}
+
+double non_negative(const cli::Args& args, const char* name, const std::string& command) {
+  const double v = args.get_double(name, 0.0);
+  if (!(v >= 0.0 && std::isfinite(v)))
+    throw cli::UsageError(command + ": option '--" + name + "' must be a number >= 0");
+  return v;
+}
+
+}  // namespace
+
+void add_input_options(cli::Args& args) {
+  args.option("start", "S", "use the frames from S seconds after the recording's first message")
+      .option("duration", "D", "use D seconds of frames (from --start)")
+      .option("frame-time", "header|receive",
+              "recordings: a frame's time is its header.stamp (header, default) or the time the "
+              "recorder received it (receive)");
+}
+
+InputOptions input_options(const cli::Args& args, const std::string& command) {
+  InputOptions o;
+  if (args.has("start")) o.window.start_s = non_negative(args, "start", command);
+  if (args.has("duration")) {
+    o.window.duration_s = non_negative(args, "duration", command);
+    if (*o.window.duration_s <= 0.0)
+      throw cli::UsageError(command + ": option '--duration' must be more than 0 seconds");
+  }
+  const std::string t = args.get("frame-time", "header");
+  if (t != "header" && t != "receive")
+    throw cli::UsageError(command + ": option '--frame-time': expected header or receive, got '" +
+                          t + "'");
+  o.frame_time = t == "receive" ? FrameTimeChoice::receive_time : FrameTimeChoice::header_stamp;
+  return o;
+}
+
+void print_input_warnings(const std::vector<std::unique_ptr<LidarInput>>& inputs,
+                          const std::string& command) {
+  std::set<std::string> printed;
+  for (const auto& in : inputs)
+    for (const std::string& w : in->warnings())
+      if (printed.insert(w).second)
+        std::fprintf(stderr, "ulc %s: warning: %s\n", command.c_str(), w.c_str());
+}
+
+LidarSpec parse_lidar_spec(const std::string& text, const std::string& command,
+                           const std::string& option) {
+  LidarSpec spec;
+  spec.text = text;
+  std::string rest = text;
+  const auto eq = rest.rfind('=');
+  if (eq != std::string::npos && !exists(rest) && rest.find('/', eq) == std::string::npos) {
+    spec.name = rest.substr(eq + 1);
+    rest = rest.substr(0, eq);
+    if (spec.name.empty())
+      throw cli::UsageError(command + ": option '--" + option + "': '" + text +
+                            "' has an empty name after '='");
+  }
+  if (exists(rest) || rest.find(':') == std::string::npos) {
+    spec.path = rest;
+    return spec;
+  }
+  // FILE:TOPIC - the topic follows the last ':' whose left side exists.
+  for (auto colon = rest.rfind(':'); colon != std::string::npos && colon > 0;
+       colon = rest.rfind(':', colon - 1)) {
+    if (!exists(rest.substr(0, colon))) continue;
+    spec.path = rest.substr(0, colon);
+    spec.topic = rest.substr(colon + 1);
+    if (spec.topic.empty())
+      throw cli::UsageError(command + ": option '--" + option + "': '" + text +
+                            "' has an empty topic");
+    return spec;
+  }
+  spec.path = rest;  // does not exist: the reader names it
+  return spec;
+}
+
+std::vector<std::unique_ptr<LidarInput>> open_lidar_inputs(const std::vector<LidarSpec>& specs,
+                                                           const InputOptions& options,
+                                                           const std::string& command) {
+  std::map<std::string, std::shared_ptr<Recording>> recordings;
+  std::vector<std::unique_ptr<LidarInput>> inputs;
+  for (const LidarSpec& spec : specs)
+    inputs.push_back(open_one(spec, options, recordings, command));
+  disambiguate(inputs, specs);
+  for (std::size_t i = 0; i < inputs.size(); ++i)
+    if (!specs[i].name.empty()) inputs[i]->set_name(specs[i].name);
+  require_unique_names(inputs, command);
+  return inputs;
+}
+
+}  // namespace ulc::app
