@@ -3,6 +3,7 @@
 // bags other tools wrote exactly as their README says; `ulc export` writes the frames back;
 // topics that are missing or not clouds, and damaged files, are one clear line and exit 2;
 // LiDAR names never collide into an error.
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <filesystem>
@@ -113,6 +114,17 @@ TEST_CASE("ulc export writes a recording's topic back as the frames it came from
   INFO(part.output);
   REQUIRE(part.exit_code == 0);
   CHECK(ulc::io::Sequence(d.path("part/lidar32")).size() == 3);
+  // The same window over the frame folder.
+  const auto folder =
+      run_command(kUlc + " export --start 0.2 --duration 0.3 " + quote(d.path("folders/lidar32")) +
+                  " " + quote(d.path("part_folder")));
+  INFO(folder.output);
+  REQUIRE(folder.exit_code == 0);
+  const ulc::io::Sequence from_bag(d.path("part/lidar32")),
+      from_folder(d.path("part_folder/lidar32"));
+  REQUIRE(from_folder.size() == 3);
+  for (std::size_t i = 0; i < 3; ++i)
+    CHECK(std::abs(from_folder.frame(i).timestamp - from_bag.frame(i).timestamp) < 1e-9);
 }
 
 TEST_CASE("ulc inspect lists a recording's topics and describes a cloud topic", "[app][bags]") {
@@ -159,39 +171,80 @@ TEST_CASE("missing topics, non-cloud topics and damaged recordings: one line, ex
   CHECK_THAT(run.output, Catch::Contains(cut) && Catch::Contains("byte "));
 }
 
+namespace {
+
+struct TopicLine {
+  std::string topic, type;
+  int count;
+};
+
+/// `ulc inspect FILE` lists each topic on its own line with its type and message count.
+void expect_topics(const std::filesystem::path& file, const std::vector<TopicLine>& topics,
+                   std::size_t total_topics) {
+  const auto run = run_command(kUlc + " inspect " + quote(file.string()));
+  INFO(run.output);
+  REQUIRE(run.exit_code == 0);
+  CHECK_THAT(run.output, Catch::Contains(": " + std::to_string(total_topics) + " topic"));
+  for (const auto& t : topics) {
+    CAPTURE(t.topic);
+    const auto at = run.output.find("  " + t.topic + " ");
+    REQUIRE(at != std::string::npos);
+    const std::string line = run.output.substr(at, run.output.find('\n', at) - at);
+    CHECK_THAT(line, Catch::Contains(" " + t.type + " ") &&
+                         Catch::Contains(" " + std::to_string(t.count) + " msgs"));
+  }
+  CHECK_THAT(run.output, Catch::Contains("point-cloud topics: none"));
+}
+
+}  // namespace
+
 TEST_CASE("real bags: ulc inspect lists every topic, type and count", "[app][bags]") {
   const auto dir = ulc_test::bags_dir();
   ULC_SKIP_UNLESS(!dir.empty(), "../shared/data/bags not found next to the checkout");
-  auto run = run_command(kUlc + " inspect " + quote((dir / "ros1/example.bag").string()));
-  INFO(run.output);
-  REQUIRE(run.exit_code == 0);
-  for (const auto& [topic, count] :
-       std::vector<std::pair<std::string, int>>{{"/turtle1/color_sensor", 1351},
-                                                {"/turtle2/color_sensor", 1344},
-                                                {"/turtle1/pose", 1344},
-                                                {"/turtle2/pose", 1344},
-                                                {"/tf", 2688},
-                                                {"/rosout", 10},
-                                                {"/tf_static", 1},
-                                                {"/turtle1/cmd_vel", 357},
-                                                {"/turtle2/cmd_vel", 208}}) {
-    CAPTURE(topic);
-    const auto at = run.output.find("  " + topic + " ");
-    REQUIRE(at != std::string::npos);
-    const std::string line = run.output.substr(at, run.output.find('\n', at) - at);
-    CHECK_THAT(line, Catch::Contains(" " + std::to_string(count) + " msgs"));
+  const std::vector<TopicLine> turtles = {{"/turtle1/color_sensor", "turtlesim/Color", 1351},
+                                          {"/turtle2/color_sensor", "turtlesim/Color", 1344},
+                                          {"/turtle1/pose", "turtlesim/Pose", 1344},
+                                          {"/turtle2/pose", "turtlesim/Pose", 1344},
+                                          {"/tf", "tf/tfMessage", 2688},
+                                          {"/rosout", "rosgraph_msgs/Log", 10},
+                                          {"/tf_static", "tf2_msgs/TFMessage", 1},
+                                          {"/turtle1/cmd_vel", "geometry_msgs/Twist", 357},
+                                          {"/turtle2/cmd_vel", "geometry_msgs/Twist", 208}};
+  for (const char* f : {"example.bag", "example-bz2.bag", "example-lz4.bag"})
+    expect_topics(dir / "ros1" / f, turtles, 9);
+  expect_topics(dir / "ros1/example-unsorted-chunks.bag", {{"foo", "std_msgs/String", 3}}, 1);
+  expect_topics(dir / "ros1/no-messages.bag", {}, 0);
+  for (const char* storage : {"mcap", "sqlite3"}) {
+    CAPTURE(storage);
+    const auto root = dir / "ros2" / storage;
+    expect_topics(root / "talker",
+                  {{"/topic", "std_msgs/msg/String", 10},
+                   {"/rosout", "rcl_interfaces/msg/Log", 10},
+                   {"/parameter_events", "rcl_interfaces/msg/ParameterEvent", 0}},
+                  3);
+    expect_topics(root / "wbag",
+                  {{"AAA", "std_msgs/msg/String", 804},
+                   {"BBB", "std_msgs/msg/String", 742},
+                   {"CCC", "std_msgs/msg/String", 742},
+                   {"DDD", "std_msgs/msg/String", 753},
+                   {"EEE", "std_msgs/msg/String", 804},
+                   {"FFF", "std_msgs/msg/String", 772},
+                   {"GGG", "std_msgs/msg/String", 731},
+                   {"HHH", "std_msgs/msg/String", 726}},
+                  8);
+    expect_topics(
+        root / "convert_a",
+        {{"a_empty", "test_msgs/msg/Empty", 100}, {"b_basictypes", "test_msgs/msg/BasicTypes", 50}},
+        2);
+    expect_topics(root / "cdr_test",
+                  {{"/test_topic", "test_msgs/msg/BasicTypes", 3},
+                   {"/array_topic", "test_msgs/msg/Arrays", 4}},
+                  2);
   }
-  CHECK_THAT(run.output, Catch::Contains("point-cloud topics: none"));
-
-  run = run_command(kUlc + " inspect " + quote((dir / "ros2/mcap/talker").string()));
-  INFO(run.output);
-  REQUIRE(run.exit_code == 0);
-  CHECK_THAT(run.output,
-             Catch::Contains("std_msgs/msg/String") && Catch::Contains("/parameter_events"));
-
-  run = run_command(kUlc + " inspect " + quote((dir / "ros1/empty-file.bag").string()));
+  const auto run = run_command(kUlc + " inspect " + quote((dir / "ros1/empty-file.bag").string()));
   CHECK(run.exit_code == 2);
   CHECK_THAT(run.output, Catch::Contains("empty-file.bag") && Catch::Contains("empty"));
+  CHECK(std::count(run.output.begin(), run.output.end(), '\n') == 1);
 }
 
 TEST_CASE("LiDAR names: repeated stems take their folder, =NAME names explicitly", "[app][bags]") {
