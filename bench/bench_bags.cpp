@@ -2,7 +2,8 @@
 // VLP-32C, PointCloud2 with x y z intensity and Velodyne `time`) as a ROS 1 bag, an MCAP file and
 // a zstd MCAP of --gb GiB (default 1) and of --big-gb GiB (default 4; 0 skips them), then reads
 // every cloud message back and decodes it into points with per-point times, as `ulc calibrate`
-// does. Each read runs in a child process, so its peak resident memory is its own.
+// does. Each read runs in a fresh process (this program with --read-child), so its peak resident
+// memory (VmHWM) is the reader's own.
 //
 //   ./build/bench/bench_bags [--json] [--repeats N] [--gb G] [--big-gb G] [--dir DIR]
 //
@@ -11,13 +12,10 @@
 // raw speed), and the child's peak RSS. The files are read right after being written, so they
 // come from the page cache: the figures are the reader's speed, not the disk's. The big files
 // show that memory does not grow with the recording's length.
-#include <sys/resource.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -104,38 +102,48 @@ struct ReadRun {
   long peak_kib = 0;
 };
 
-/// Reads and decodes every cloud message of `file` in a child process.
-ReadRun read_in_child(const fs::path& file) {
-  int fds[2];
-  if (pipe(fds) != 0) std::exit(1);
-  const pid_t pid = fork();
-  if (pid == 0) {
-    close(fds[0]);
-    ReadRun r;
-    r.seconds = ulc_bench::seconds_of([&] {
-      const auto rec = ulc::bags::open_recording(file);
-      std::vector<std::size_t> all;
-      for (std::size_t i = 0; i < rec->topics().size(); ++i) all.push_back(i);
-      auto cursor = rec->cursor(all, {});
-      ulc::bags::MessageView m;
-      while (cursor->next(m)) {
-        const auto& topic = rec->topics()[m.topic];
-        r.points +=
-            ulc::bags::decode_cloud_message(*ulc::bags::cloud_message_type(topic.type), topic, m)
-                .cloud.size();
-      }
-    });
-    if (write(fds[1], &r, sizeof r) != static_cast<ssize_t>(sizeof r)) _exit(1);
-    _exit(0);
-  }
-  close(fds[1]);
+/// Reads and decodes every cloud message of `file`, as the pipeline does.
+ReadRun read_recording(const fs::path& file) {
   ReadRun r;
-  if (read(fds[0], &r, sizeof r) != static_cast<ssize_t>(sizeof r)) std::exit(1);
-  close(fds[0]);
-  int status = 0;
-  struct rusage usage {};
-  wait4(pid, &status, 0, &usage);
-  r.peak_kib = usage.ru_maxrss;
+  r.seconds = ulc_bench::seconds_of([&] {
+    const auto rec = ulc::bags::open_recording(file);
+    std::vector<std::size_t> all;
+    for (std::size_t i = 0; i < rec->topics().size(); ++i) all.push_back(i);
+    auto cursor = rec->cursor(all, {});
+    ulc::bags::MessageView m;
+    while (cursor->next(m)) {
+      const auto& topic = rec->topics()[m.topic];
+      r.points +=
+          ulc::bags::decode_cloud_message(*ulc::bags::cloud_message_type(topic.type), topic, m)
+              .cloud.size();
+    }
+  });
+  return r;
+}
+
+/// This process's peak resident memory (VmHWM), KiB.
+long peak_rss_kib() {
+  std::ifstream status("/proc/self/status");
+  std::string key;
+  long value = 0;
+  while (status >> key)
+    if (key == "VmHWM:" && status >> value) return value;
+  return 0;
+}
+
+/// read_recording in a fresh process (this program, `--read-child FILE`), so that the peak
+/// memory is the reader's alone, not the simulated frames this process holds.
+ReadRun read_in_child(const std::string& self, const fs::path& file) {
+  const std::string command = "'" + self + "' --read-child '" + file.string() + "'";
+  FILE* pipe = popen(command.c_str(), "r");
+  ReadRun r;
+  unsigned long long points = 0;
+  if (!pipe || std::fscanf(pipe, "%lf %llu %ld", &r.seconds, &points, &r.peak_kib) != 3) {
+    std::cerr << "the reading child failed: " << command << "\n";
+    std::exit(1);
+  }
+  pclose(pipe);
+  r.points = points;
   return r;
 }
 
@@ -152,6 +160,12 @@ double raw_read_seconds(const fs::path& file) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (argc == 3 && std::strcmp(argv[1], "--read-child") == 0) {
+    const ReadRun r = read_recording(argv[2]);
+    std::printf("%.9f %llu %ld\n", r.seconds, static_cast<unsigned long long>(r.points),
+                peak_rss_kib());
+    return 0;
+  }
   double gb = 1.0, big_gb = 4.0;
   fs::path dir = fs::temp_directory_path() / "ulc_bench_bags";
   ulc_bench::Args args;
@@ -177,7 +191,7 @@ int main(int argc, char** argv) {
       ReadRun last;
       for (int r = 0; r < repeats; ++r) {
         raw.push_back(raw_read_seconds(file));
-        last = read_in_child(file);
+        last = read_in_child(argv[0], file);
         decode.push_back(last.seconds);
       }
       std::sort(decode.begin(), decode.end());

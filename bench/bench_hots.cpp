@@ -69,6 +69,7 @@
 #include "support/bench_util.hpp"
 #include "support/curve_png.hpp"
 #include "ulc/calibrate.hpp"
+#include "ulc/calibrate/pipeline.hpp"
 #include "ulc/core/pose_error.hpp"
 #include "ulc/sim/simulate.hpp"
 

@@ -30,6 +30,7 @@
 #include "support/bench_args.hpp"
 #include "support/bench_util.hpp"
 #include "ulc/calibrate.hpp"
+#include "ulc/calibrate/pipeline.hpp"
 #include "ulc/core/pose_error.hpp"
 
 namespace {

@@ -6,7 +6,7 @@ include(CMakePackageConfigHelpers)
 
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
         FILES_MATCHING PATTERN "*.hpp")
-install(TARGETS ulc EXPORT ulcTargets)
+install(TARGETS ulc ulc_calibrate EXPORT ulcTargets ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
 install(EXPORT ulcTargets NAMESPACE ulc:: DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/ulc)
 # The recording readers are a component of their own, so that find_package(ulc) alone needs only
 # the three core dependencies: find_package(ulc CONFIG REQUIRED COMPONENTS bags) -> ulc::bags.

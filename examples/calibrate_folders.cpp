@@ -1,6 +1,6 @@
 // Calibrating from PCD folders with the library: two LiDARs' frame folders in, the extrinsic
-// out as the result file `ulc calibrate` writes (DESIGN.md). The command does the same with more
-// options; this is what to copy into your own tool.
+// out as the result file `ulc calibrate` writes (docs/design.md). The command does the same with
+// more options; this is what to copy into your own tool.
 //
 //   example_calibrate_folders BASE_DIR TARGET_DIR [result.json]
 //   example_calibrate_folders                      (simulates a 3 s 64-32 drive first)

@@ -1,6 +1,7 @@
 // Your own point struct through the whole calibration: ulc::calibrate_pair reads the frames
-// in place through the traits (see custom_point_type.cpp for the two ways to plug a type in),
-// with no copy into a ULC type.
+// through the traits (see custom_point_type.cpp for the two ways to plug a type in) and adapts
+// them once into the compiled pipeline's PointCloud<float> (link ulc::calibrate; this file then
+// compiles in seconds).
 //
 // The frames come from ULC's simulator here (a short drive of the 64-32 rig, exact ground
 // truth), copied into a vehicle stack's own struct, as a driver would deliver them; then the

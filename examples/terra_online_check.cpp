@@ -20,7 +20,8 @@
 namespace {
 
 constexpr double kDeg = 3.14159265358979323846 / 180.0;
-constexpr double kAlarmDeg = 10.0;  // DESIGN.md: a rotation initialisation succeeds below 10 deg
+constexpr double kAlarmDeg =
+    10.0;  // docs/design.md: a rotation initialisation succeeds below 10 deg
 
 struct Check {
   ulc::PointCloud<float> base, target;

@@ -1,5 +1,5 @@
 // `ulc calibrate`: the extrinsic of every target LiDAR against the base, through the stages asked
-// for (terra, jeep, hots), written as the result file of DESIGN.md and summarised on stdout.
+// for (terra, jeep, hots), written as the result file of docs/design.md and summarised on stdout.
 // The targets form a rig (ulc/calibrate/rig.hpp): a target that fails against the base is routed
 // through one that succeeded, and with two targets or more the cycles between them are closed.
 #include <tbb/task_arena.h>
@@ -152,7 +152,7 @@ int run_calibrate(int argc, char** argv) {
               ".mcap, rosbag2 folder, .db3); add =NAME to name it",
               true)
       .option("target", "SOURCE", "a target LiDAR, as --base", true, true)
-      .option("output", "FILE", "write the result file (DESIGN.md) here")
+      .option("output", "FILE", "write the result file (docs/design.md) here")
       .option("format", "json|yaml",
               "format of --output (default json; yaml adds ROS and URDF forms of each extrinsic)")
       .option("merged-cloud", "PCD",

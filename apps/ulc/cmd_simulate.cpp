@@ -1,4 +1,4 @@
-// `ulc simulate`: writes a dataset folder (DESIGN.md) for a named rig and scene, with exact
+// `ulc simulate`: writes a dataset folder (docs/design.md) for a named rig and scene, with exact
 // ground truth, and optionally a top-down preview of every LiDAR's first frame.
 #include <cmath>
 #include <cstdio>

@@ -1,6 +1,7 @@
 // `--initial` of `ulc calibrate`: "x y z roll pitch yaw" (metres, degrees, R = Rz(yaw) Ry(pitch)
-// Rx(roll), the ROS convention) or a result file (DESIGN.md, "The command line"). From a result
-// file, the entry for the same base and target is used when there is one, else the first entry.
+// Rx(roll), the ROS convention) or a result file (docs/design.md, "The command line"). From a
+// result file, the entry for the same base and target is used when there is one, else the first
+// entry.
 #pragma once
 
 #include <Eigen/Geometry>

@@ -1,5 +1,5 @@
 // `ulc`: the command-line front end. Dispatches to a subcommand and turns exceptions into one
-// clear line on stderr and an exit code (DESIGN.md, "The command line").
+// clear line on stderr and an exit code (docs/design.md, "The command line").
 #include <cstdio>
 #include <cstring>
 #include <exception>

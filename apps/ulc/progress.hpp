@@ -1,4 +1,4 @@
-// Progress on stderr, as DESIGN.md asks: a redrawn bar on a terminal, plain lines when piped
+// Progress on stderr, as docs/design.md asks: a redrawn bar on a terminal, plain lines when piped
 // (one line per 10 %), nothing with --quiet.
 #pragma once
 

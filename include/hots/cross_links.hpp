@@ -40,26 +40,12 @@
 #include <tbb/parallel_for.h>
 
 #include "hots/hierarchy.hpp"
+#include "hots/options.hpp"
 #include "ulc/core/point_to_plane.hpp"
 #include "ulc/core/registration_target.hpp"
 #include "ulc/core/voxel_downsample.hpp"
 
 namespace hots {
-
-struct CrossLinkOptions {
-  int min_layer = 0;  ///< layers min_layer .. top are linked
-  /// At layer 0, every n-th a frame: one link per window, as the layers above have. Every frame
-  /// (1) cost 2.5x the link time on bench_hots 64-32 for no better extrinsic.
-  std::size_t layer0_stride = 5;
-  double source_voxel = 0.5;  ///< m, b's cloud (registered points) thinning; 0: none
-  double target_voxel = 0.5;  ///< m, a's cloud (planes) thinning; 0: none
-  double gate = 1.0;          ///< first registration stage's gate, m
-  double min_inlier_ratio = 0.3;
-  double min_sigma = 0.01;                                     ///< m
-  double agree_rotation_rad = 1.0 * 3.14159265358979 / 180.0;  ///< see the conventions
-  double agree_translation_m = 1.0;
-  ulc::PlaneCloudOptions planes;
-};
 
 struct CrossLink {
   std::size_t frame_a = 0, frame_b = 0;  ///< anchor frames

@@ -36,6 +36,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "hots/options.hpp"
 #include "hots/pose_graph.hpp"
 #include "hots/sweep_ba.hpp"
 #include "hots/window_ba.hpp"
@@ -43,38 +44,6 @@
 #include "ulc/core/voxel_downsample.hpp"
 
 namespace hots {
-
-struct HierarchyOptions {
-  std::size_t window = 5;
-  int layers = 3;
-  /// One plane extraction per window, in 2 m root voxels: the odometry's poses are already
-  /// within centimetres, so the second extraction (window_ba.hpp, rounds) halved the
-  /// hierarchy's speed and 1 m roots (more, smaller planes) cost a third more, for nothing
-  /// measurable on the 64-32 and 64-horizon drives (docs/BENCHMARKS.md, bench_hots).
-  WindowBaOptions ba = hots_window_ba();
-  double submap_voxel = 0.2;  ///< m
-
-  static WindowBaOptions hots_window_ba() {
-    WindowBaOptions o;
-    o.rounds = 1;
-    o.planes.voxel_size = 2.0;
-    return o;
-  }
-  /// Floor of the BA noise estimate (m): a near-perfect window does not dominate the graph.
-  double min_sigma = 1e-3;
-  /// Layer 0 with continuous-time sweeps (sweep_ba.hpp) when the caller gives the frames'
-  /// parts: each window's last sweep ends at the next frame's pose (a variable of the window,
-  /// not returned) when end_knot, else it stays as deskewed.
-  bool end_knot = true;
-  /// With end_knot: the window's estimate of the next frame's pose also becomes a factor (from
-  /// the window's anchor to that frame, its marginal information): the windows of layer 0 tie
-  /// to each other directly.
-  bool end_knot_factor = false;
-  /// Parts per sweep for the continuous-time layer 0 (refine() splits the frames); 1: rigid.
-  /// Two by default: on the 60 s 64-32 drives the sweeps lower HOTS's trajectory error
-  /// (docs/BENCHMARKS.md, sessions 19-21) for +0.5 GB (the parts are a second copy of the frames).
-  int sweep_parts = 2;
-};
 
 /// One frame's sweep for a continuous-time layer 0: its points in parts by time, each part's
 /// mean fraction of the frame period, and the motion the points were deskewed with.

@@ -13,7 +13,7 @@
 //     each point's own time, per-point times relative to the frame timestamp when the cloud has
 //     them), timestamps (own clocks), poses_a = T_mapa_a and poses_b = T_mapb_b at the frame
 //     timestamps, each LiDAR in its own map frame (as jeep's odometry gives them), and the
-//     extrinsic C = T_base_target. Clock offset: t_a = t_b + time_offset_s (DESIGN.md).
+//     extrinsic C = T_base_target. Clock offset: t_a = t_b + time_offset_s (docs/design.md).
 //   - The two maps are put in one world (map a) by T_mapa_mapb = P_a(t_a0) C P_b(t_a0)^-1 at
 //     a's first frame, b's pose interpolated to that instant (identity-free for jeep's
 //     odometry, whose map b is b's frame at a's first instant: T_mapa_mapb = C).
@@ -73,7 +73,9 @@
 #include "hots/boundary_links.hpp"
 #include "hots/cross_links.hpp"
 #include "hots/hierarchy.hpp"
+#include "hots/options.hpp"
 #include "hots/pose_graph.hpp"
+#include "hots/refine_statistics.hpp"
 #include "hots/sequence_extrinsic.hpp"
 #include "hots/sparse_lm.hpp"
 #include "hots/time_sync.hpp"
@@ -82,109 +84,6 @@
 #include "ulc/core/voxel_downsample.hpp"
 
 namespace hots {
-
-struct RefineOptions {
-  /// m, per-frame downsampling before the BA: the BA's cost is per plane, not per point, and
-  /// 0.2 m keeps the planes (the hierarchy's cells are 0.5 m and up) and cut the hierarchy's
-  /// time by a quarter against 0.1 m on bench_hots 64-32.
-  double frame_voxel = 0.2;
-  HierarchyOptions hierarchy;
-  CrossLinkOptions links;
-  SparseLmOptions solver;
-  double extrinsic_sigma_m = 0.05;     ///< per tie
-  double extrinsic_sigma_rad = 0.003;  ///< per tie
-  double link_huber = 3.0;             ///< whitened units
-  /// The hierarchy's top-layer submaps share no BA window, so nothing in the graph would tie
-  /// one to the next. With boundary_bridges a window BA over the top layer's members on both
-  /// sides of each boundary ties them (boundary_bridges.hpp). Where there is no usable bridge,
-  /// with boundary_registration each submap is registered to the next
-  /// (boundary_links.hpp, Huber link_huber); where that fails, or without it, the odometry's
-  /// step across the boundary (last frame of a submap to the first of the next) becomes a
-  /// factor with these standard deviations. sigma <= 0 and no registration: no boundary factors.
-  bool boundary_bridges = true;
-  double bridge_huber = 0.0;  ///< whitened units; 0: a bridge's factors are plain least squares
-  bool boundary_registration = true;
-  /// m, the boundary registration's crop around the boundary (boundary_links.hpp); 0: none.
-  double boundary_radius_m = 0.0;
-  double boundary_sigma_m = 0.02;
-  double boundary_sigma_rad = 0.002;
-  /// Trust (see the conventions): agreeing cross links >= max(min_cross_links,
-  /// min_cross_link_ratio * attempted); min_cross_link_ratio <= 0 turns the check off.
-  double min_cross_link_ratio = 0.03;
-  std::size_t min_cross_links = 3;
-  double time_offset_s = 0.0;  ///< initial clock offset estimate (centre of the search)
-  bool synchronise_time = true;
-  TimeSyncOptions time_sync;  ///< centre_s is replaced by time_offset_s
-  int passes = 2;
-  /// The last step: C and dt from every target frame against the base's submaps
-  /// (sequence_extrinsic.hpp), started from the time synchronisation's answer.
-  SequenceExtrinsicOptions sequence;
-};
-
-enum class RefineStatus {
-  ok,
-  invalid_input,
-  graph_failed,
-  time_sync_failed,
-  sequence_failed,
-  time_offset_untrusted,  ///< the drive does not pin the clock offset down (see reason)
-  extrinsic_unconfirmed   ///< too few cross links: the LiDARs' views do not confirm C
-};
-
-inline const char* to_string(RefineStatus s) {
-  switch (s) {
-    case RefineStatus::ok:
-      return "ok";
-    case RefineStatus::invalid_input:
-      return "invalid_input";
-    case RefineStatus::graph_failed:
-      return "graph_failed";
-    case RefineStatus::sequence_failed:
-      return "sequence_failed";
-    case RefineStatus::time_offset_untrusted:
-      return "time_offset_untrusted";
-    case RefineStatus::extrinsic_unconfirmed:
-      return "extrinsic_unconfirmed";
-    default:
-      return "time_sync_failed";
-  }
-}
-
-struct RefineStatistics {
-  std::size_t windows = 0, failed_windows = 0, planes = 0;
-  std::size_t ba_factors = 0, cross_links = 0, cross_links_attempted = 0, extrinsic_ties = 0;
-  std::size_t cross_links_agreeing = 0;  ///< kept links that confirm the start (cross_links.hpp)
-  std::size_t boundary_factors = 0;      ///< top-layer submap boundaries tied in the graph
-  std::size_t boundary_links = 0;    ///< of those, by registering the submaps (the rest: odometry)
-  std::size_t boundary_bridges = 0;  ///< boundaries tied by a bridge BA (not in boundary_factors)
-  double graph_initial_cost = 0.0, graph_cost = 0.0;
-  int graph_iterations = 0;
-  double time_sync_spread = 0.0;
-  std::size_t time_sync_pairs = 0;
-  Isometry3d graph_extrinsic = Isometry3d::Identity();  ///< C as the pose graph left it
-  Isometry3d sync_extrinsic = Isometry3d::Identity();   ///< C of the time synchronisation
-  double sync_time_offset_s = 0.0;                      ///< dt of the time synchronisation
-  bool sync_significant = false;                        ///< its minimum passed the test
-  SequenceExtrinsicResult sequence;                     ///< the last step (status disabled: off)
-  double sequence_seconds = 0.0;                        ///< its wall time (statistics only)
-  /// Wall time of each phase, s (statistics only: where the stage spends its time).
-  double prepare_seconds = 0.0, hierarchy_seconds = 0.0, links_seconds = 0.0;
-  double graph_seconds = 0.0, sync_seconds = 0.0;
-};
-
-struct RefineResult {
-  RefineStatus status = RefineStatus::ok;
-  const char* reason = "";
-  Isometry3d extrinsic = Isometry3d::Identity();  ///< T_base_target
-  double time_offset_s = 0.0;
-  Mat6d covariance_6x6 = Mat6d::Zero();
-  std::vector<Isometry3d> poses_a;  ///< T_mapa_a, refined
-  std::vector<Isometry3d> poses_b;  ///< T_mapb_b, refined
-  RefineStatistics statistics;
-  std::vector<std::pair<double, double>> spread_curve;  ///< (offset, spread), last pass
-
-  bool ok() const { return status == RefineStatus::ok; }
-};
 
 namespace hots_detail {
 

@@ -28,20 +28,12 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "hots/options.hpp"
 #include "hots/point_cluster.hpp"
 #include "ulc/core/point_traits.hpp"
 #include "ulc/core/voxel.hpp"
 
 namespace hots {
-
-struct PlaneExtractionOptions {
-  double voxel_size = 1.0;        ///< root voxel edge, m
-  int max_depth = 2;              ///< octree splits below a root voxel
-  std::size_t min_points = 10;    ///< per plane, all frames together
-  std::size_t min_frames = 2;     ///< frames seeing a plane
-  double max_eigen_ratio = 0.05;  ///< lambda_0 / lambda_1 at most this
-  double max_distance = 0.12;     ///< largest distance of a point to the plane, m
-};
 
 /// A plane of the window: its anchor (the mean of its points at the extraction poses) and the
 /// cluster of each frame that sees it (frame = index into the window).

@@ -28,6 +28,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "hots/options.hpp"
 #include "ulc/core/lie.hpp"
 #include "ulc/core/types.hpp"
 
@@ -132,11 +133,6 @@ struct PlaneDerivatives {
   bool degenerate = false;
   Eigen::VectorXd gradient;
   Eigen::MatrixXd hessian;
-};
-
-struct PlaneEvaluationOptions {
-  /// Relative gap: degenerate when lambda_1 - lambda_0 <= min_gap * (trace + tiny).
-  double min_gap = 1e-9;
 };
 
 /// A plane's derivatives in factored form: per frame a, the forms w_a (6 x 3: w_a,k = u_k^T

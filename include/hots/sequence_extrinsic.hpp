@@ -12,7 +12,7 @@
 //
 // Conventions this header owns:
 //   - World = the frame of the base's poses world_a (T_world_a at times_a, a's clock). Clock
-//     offset as in DESIGN.md: t_a = t_b + dt. T_a(t) interpolates world_a (slerp + linear).
+//     offset as in docs/design.md: t_a = t_b + dt. T_a(t) interpolates world_a (slerp + linear).
 //   - Targets: the base's layer-`target_layer` submaps of the hierarchy (clouds anchored at
 //     their first frame), voxel-thinned at target_voxel, with PCA planes. Frame j's points go
 //     to the submap whose time span holds t_j + dt (else the nearest), as one point-to-plane
@@ -62,98 +62,14 @@
 #include <tbb/parallel_for.h>
 
 #include "hots/hierarchy.hpp"
+#include "hots/options.hpp"
+#include "hots/refine_statistics.hpp"
 #include "hots/time_sync.hpp"
 #include "ulc/core/point_to_plane.hpp"
 #include "ulc/core/registration_target.hpp"
 #include "ulc/core/voxel_downsample.hpp"
 
 namespace hots {
-
-struct SequenceExtrinsicOptions {
-  bool enabled = true;
-  int target_layer = 1;          ///< the base's submaps of this layer (clamped to the hierarchy)
-  double source_voxel = 0.8;     ///< m, each target frame's thinning
-  double target_voxel = 0.3;     ///< m, each base submap's thinning
-  std::size_t frame_stride = 4;  ///< every n-th target frame (2.5 per second at 10 Hz)
-  /// hots::refine deskews those frames afresh with the base's refined trajectory through C at
-  /// the starting dt, instead of b's own (unrefined) odometry: a sweep deskewed with a wrong
-  /// velocity is displaced along the motion, which reads as a clock offset. Off by default:
-  /// measured mixed (docs/BENCHMARKS.md, "Deskewing the target from the base").
-  bool deskew_from_base = false;
-  ulc::PlaneCloudOptions planes;
-  /// Coarse to fine from HOTS's start (millimetres to a few centimetres away).
-  std::vector<ulc::RegistrationOptions> stages = default_stages();
-  bool estimate_time_offset = true;
-  double time_window_s = 0.05;           ///< |dt - start| beyond this: dt not adopted
-  double max_time_sigma_s = 2e-3;        ///< dt adopted only when pinned down this well
-  std::size_t time_cluster_frames = 10;  ///< consecutive target frames sharing their errors
-  double derivative_step_s = 1e-3;       ///< central difference of the trajectory
-  double min_condition = 1e-6;           ///< eigen directions (scaled) skipped below this
-  bool check_time_offset = true;         ///< the halves' trust check (header comment)
-  /// s: the halves' offsets, and the kept offset and the whole solve's, must agree this well
-  /// (5 ms is 5 cm of translation at 10 m/s).
-  double max_time_disagreement_s = 5e-3;
-  /// The check fails first when dt's information that a change of C cannot explain
-  /// (time_observability) is below this share: 0.1 is a variance inflation of 10, the usual
-  /// threshold of serious collinearity (60 s drives: 0.2-0.5; 6 s drives: 0.001-0.01).
-  double min_time_observability = 0.1;
-
-  static std::vector<ulc::RegistrationOptions> default_stages() {
-    ulc::RegistrationOptions coarse, fine;
-    coarse.max_correspondence_distance = 0.5;
-    coarse.kernel = ulc::RobustKernel::geman_mcclure(0.1);
-    coarse.max_iterations = 8;
-    coarse.max_solver_iterations = 3;
-    coarse.translation_tolerance = 1e-3;
-    coarse.rotation_tolerance = 1e-4;
-    fine.max_correspondence_distance = 0.25;
-    fine.kernel = ulc::RobustKernel::geman_mcclure(0.03);
-    fine.max_iterations = 8;
-    fine.max_solver_iterations = 3;
-    fine.translation_tolerance = 5e-5;
-    fine.rotation_tolerance = 5e-6;
-    return {coarse, fine};
-  }
-};
-
-enum class SequenceExtrinsicStatus { ok, disabled, invalid_input, registration_failed };
-
-inline const char* to_string(SequenceExtrinsicStatus s) {
-  switch (s) {
-    case SequenceExtrinsicStatus::ok:
-      return "ok";
-    case SequenceExtrinsicStatus::disabled:
-      return "disabled";
-    case SequenceExtrinsicStatus::invalid_input:
-      return "invalid_input";
-    default:
-      return "registration_failed";
-  }
-}
-
-struct SequenceExtrinsicResult {
-  SequenceExtrinsicStatus status = SequenceExtrinsicStatus::disabled;
-  const char* reason = "";
-  Isometry3d extrinsic = Isometry3d::Identity();
-  double time_offset_s = 0.0;
-  bool time_offset_refined = false;    ///< dt was pinned down and adopted
-  double joint_time_offset_s = 0.0;    ///< the 7-parameter solve's dt (adopted or not)
-  double time_sigma_s = 0.0;           ///< its marginal standard deviation (inf: unobservable)
-  bool time_offset_checked = false;    ///< the halves' trust check ran
-  bool time_offset_trusted = true;     ///< it passed (true when it did not run)
-  const char* time_offset_doubt = "";  ///< why not, one sentence
-  double half_time_offset_s[2] = {0.0, 0.0};  ///< the first and the second half's dt
-  /// 1 / (H_77 (H^-1)_77) of the joint normal matrix: the share of dt's information that a
-  /// change of C cannot explain (1: independent of C, 0: a translation along the road would do).
-  double time_observability = 0.0;
-  std::size_t frames = 0, targets = 0, source_points = 0;
-  std::size_t correspondences = 0, inliers = 0;
-  double rmse = 0.0;   ///< m, inliers at the result
-  double cost = 0.0;   ///< final robust cost at the result
-  int iterations = 0;  ///< matchings, all solves and stages
-
-  bool ok() const { return status == SequenceExtrinsicStatus::ok; }
-};
 
 namespace sequence_detail {
 

@@ -33,18 +33,10 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "hots/options.hpp"
 #include "hots/pose_graph.hpp"
 
 namespace hots {
-
-struct SparseLmOptions {
-  int max_iterations = 50;
-  double initial_damping = 1e-4;  ///< mu_0 (relative to diag(H))
-  double step_tolerance = 1e-9;   ///< m and rad
-  double cost_tolerance = 1e-12;  ///< relative cost decrease of an accepted step
-  double min_diagonal = 1e-9;     ///< diag(H) entries below this are lifted (in the damping)
-  std::size_t grain = 256;        ///< factors per parallel task (fixed)
-};
 
 enum class SparseLmStatus { ok, not_converged, invalid_input, solver_failed };
 

@@ -6,7 +6,7 @@
 //
 // Conventions this header owns:
 //   - Poses T_world_a at a's frame times (a's clock) and T_world_b at b's frame times (b's
-//     clock), in the same world frame. Clock offset as in DESIGN.md: t_a = t_b + dt, so a's
+//     clock), in the same world frame. Clock offset as in docs/design.md: t_a = t_b + dt, so a's
 //     instant t_i is b's clock time t_i - dt.
 //   - P_b(t) between two b frames: rotation by slerp, translation linear (ulc::interpolate,
 //     constant velocity between frames, as the paper's alpha-interpolation).
@@ -38,6 +38,7 @@
 
 #include <Eigen/QR>
 
+#include "hots/options.hpp"
 #include "ulc/core/lie.hpp"
 #include "ulc/core/rotation_mean.hpp"
 #include "ulc/core/types.hpp"
@@ -49,20 +50,6 @@ using ulc::Mat3d;
 using ulc::Mat6d;
 using ulc::Vec3d;
 using ulc::Vec6d;
-
-struct TimeSyncOptions {
-  double centre_s = 0.0;        ///< the search is centred here
-  double search_periods = 1.0;  ///< half width, in a's frame periods
-  int grid_samples = 41;        ///< coarse scan before the golden section (>= 3)
-  double tolerance_s = 1e-5;    ///< golden-section stop (interval width)
-  double rotation_scale_m = 10.0;
-  std::size_t min_pairs = 10;
-  /// The found offset replaces centre_s only when n (spread(centre) - spread(dt*)) exceeds this
-  /// many times spread(dt*): on a drive at nearly constant velocity the curve is flat and its
-  /// minimum is decided by pose noise (fitting one parameter to pure noise lowers n * spread by
-  /// about one per-pair variance), which would turn noise into a biased translation.
-  double min_significance = 4.0;
-};
 
 enum class TimeSyncStatus { ok, invalid_input, too_few_pairs, at_search_edge };
 

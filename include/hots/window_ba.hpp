@@ -28,26 +28,13 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
 
+#include "hots/options.hpp"
 #include "hots/plane_extraction.hpp"
 #include "hots/point_cluster.hpp"
 #include "ulc/core/lie.hpp"
 #include "ulc/core/parallel_reduce.hpp"
 
 namespace hots {
-
-struct WindowBaOptions {
-  PlaneExtractionOptions planes;
-  /// Plane extractions: after the first converges, planes are extracted again at the refined
-  /// poses (cells that mixed two surfaces at a poor start separate) and LM runs again.
-  int rounds = 2;
-  int max_iterations = 30;        ///< LM steps per round
-  double initial_damping = 1e-4;  ///< mu_0 = this * max diagonal of the Hessian
-  double step_tolerance = 1e-8;   ///< stop when every step entry (m, rad) is below this
-  double cost_tolerance = 1e-10;  ///< stop when an accepted step lowers the cost by less (rel.)
-  std::size_t min_planes = 10;
-  PlaneEvaluationOptions evaluation;
-  std::size_t grain = 32;  ///< planes per parallel chunk (fixed: results never depend on it)
-};
 
 enum class WindowBaStatus { ok, not_converged, too_few_planes, invalid_input };
 

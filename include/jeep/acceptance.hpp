@@ -59,7 +59,7 @@
 //     small risk of accepting two unrelated streets.
 //   - min_condition is the registration's own degeneracy threshold: an alignment resting on
 //     the ground alone is not a calibration. bench_jeep --separation measures both
-//     distributions on the paper's pairs (DESIGN.md: measure, do not guess).
+//     distributions on the paper's pairs (docs/design.md: measure, do not guess).
 #pragma once
 
 #include <algorithm>
@@ -70,6 +70,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "jeep/map_registration.hpp"
+#include "jeep/options.hpp"
 #include "ulc/core/normal_equations.hpp"
 #include "ulc/core/parallel_reduce.hpp"
 #include "ulc/core/point_to_plane.hpp"
@@ -78,16 +79,6 @@
 #include "ulc/core/types.hpp"
 
 namespace jeep {
-
-struct AcceptanceOptions {
-  double voxel = 0.5;                     ///< m, both maps' resolution for the evidence
-  double gate = 1.0;                      ///< m, "near": a plane of the other map within this
-  double inlier_distance = 0.1;           ///< m, "agreeing": the success threshold of the paper
-  double min_off_ground_overlap = 0.25;   ///< see the header comment
-  double min_directional_overlap = 0.10;  ///< the floor over all six directions
-  double min_condition = 1e-3;            ///< as RegistrationOptions::min_condition
-  std::size_t min_agreeing = 100;
-};
 
 struct AcceptanceReport {
   bool accepted = false;

@@ -1,7 +1,7 @@
 // Pairing the frames of a base LiDAR a and a target LiDAR b by timestamp.
 //
 // Conventions this header owns:
-//   - Timestamps are seconds in each LiDAR's own clock (DESIGN.md); b's are brought to a's
+//   - Timestamps are seconds in each LiDAR's own clock (docs/design.md); b's are brought to a's
 //     clock with t_base = t_target + time_offset_s.
 //   - Each a frame pairs with the b frame nearest in time, when the gap is at most max_gap
 //     (JEEP uses half of a's frame period). A b frame pairs at most once: when two a frames

@@ -34,6 +34,7 @@
 #include "jeep/frame_pairing.hpp"
 #include "jeep/map_registration.hpp"
 #include "jeep/odometry.hpp"
+#include "jeep/options.hpp"
 #include "jeep/run_odometry.hpp"
 #include "jeep/scan_preparation.hpp"
 #include "jeep/second_look.hpp"
@@ -44,30 +45,6 @@
 #include "ulc/core/types.hpp"
 
 namespace jeep {
-
-struct JeepOptions {
-  std::size_t frames = 5;  ///< K, frame pairs used
-  int max_rounds = 10;     ///< more rounds without settling is a failure
-  OdometryOptions odometry = jeep_pose_phase_options();
-  MapRegistrationOptions calibration = default_map_registration();
-  /// The first calibration phase also starts from turned and shifted copies of the initial
-  /// extrinsic and keeps the best basin (start_search.hpp).
-  StartSearchOptions start_search;
-  /// Calibration stages (the last ones) used after the first round, when C moves little.
-  std::size_t refine_stages = 2;
-  /// Settled when a round moves C and every pose by less than this: a fourth of the 2 cm and
-  /// a fifth of the 0.1 deg JEEP aims at, a twentieth of the paper's success thresholds.
-  double settle_translation = 0.005;  ///< m
-  double settle_rotation = 3.5e-4;    ///< rad (0.02 deg)
-  AcceptanceOptions acceptance;
-  /// Opt-in: a refusal for the off-ground overlap alone gets a second look (second_look.hpp).
-  SecondLookOptions second_look;
-  /// Frame period when the timestamps cannot tell (a single frame): DESIGN.md's 10 Hz.
-  double default_period = 0.1;
-  /// Once settled, meet map a registered to map b's planes halfway (two_way.hpp), so that
-  /// swapping base and target gives the inverse extrinsic.
-  bool two_way = true;
-};
 
 enum class JeepStatus {
   ok,

@@ -33,6 +33,7 @@
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
 
+#include "jeep/options.hpp"
 #include "ulc/core/registration_types.hpp"
 #include "ulc/core/types.hpp"
 #include "ulc/core/voxel.hpp"
@@ -44,16 +45,6 @@ using ulc::Mat3d;
 using ulc::PlaneMatch;
 using ulc::Vec3;
 using ulc::Vec3d;
-
-struct LocalMapOptions {
-  double voxel_size = 1.0;                ///< m
-  std::size_t max_points_per_voxel = 20;  ///< cap per voxel
-  double min_point_distance = 0.2;        ///< m, between points of one voxel
-  double max_distance = 100.0;            ///< m, voxels further from the sensor are dropped
-  double prune_step = 10.0;               ///< m of sensor travel between pruning checks
-  std::size_t normal_k = 8;               ///< neighbours of each plane fit
-  double min_planarity = 0.5;             ///< (l2 - l1) / l2 of a usable plane
-};
 
 inline bool valid_local_map_options(const LocalMapOptions& o) {
   return o.voxel_size > 0.0 && std::isfinite(o.voxel_size) && o.max_points_per_voxel >= 1 &&

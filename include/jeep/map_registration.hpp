@@ -15,6 +15,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "jeep/options.hpp"
 #include "ulc/core/lie.hpp"
 #include "ulc/core/point_cloud.hpp"
 #include "ulc/core/point_to_plane.hpp"
@@ -29,37 +30,6 @@ using ulc::Isometry3d;
 using ulc::RegistrationOptions;
 using ulc::RegistrationResult;
 using ulc::Vec3;
-
-struct MapStage {
-  double source_voxel = 0.25;  ///< m
-  RegistrationOptions registration;
-};
-
-struct MapRegistrationOptions {
-  double target_voxel = 0.3;  ///< m
-  ulc::PlaneCloudOptions planes;
-  std::vector<MapStage> stages;
-};
-
-/// One stage: gate, Geman-McClure scale and source resolution; tolerances 1e-4 m, 1e-5 rad.
-inline MapStage map_stage(double source_voxel, double gate, double kernel,
-                          int max_iterations = 30) {
-  MapStage s;
-  s.source_voxel = source_voxel;
-  s.registration.max_iterations = max_iterations;
-  s.registration.max_correspondence_distance = gate;
-  s.registration.kernel = ulc::RobustKernel::geman_mcclure(kernel);
-  s.registration.inlier_distance = 0.1;
-  return s;
-}
-
-/// Coarse to fine from the paper's disturbance (5 deg, 2 m) to the data's accuracy.
-inline MapRegistrationOptions default_map_registration() {
-  MapRegistrationOptions o;
-  o.stages = {map_stage(1.0, 4.0, 1.0), map_stage(0.5, 1.5, 0.3), map_stage(0.4, 0.6, 0.1),
-              map_stage(0.4, 0.3, 0.03)};
-  return o;
-}
 
 /// sum_k T_k * scan_k: the scans' points in the map frame.
 template <typename S>

@@ -31,6 +31,7 @@
 
 #include "jeep/frame_pairing.hpp"
 #include "jeep/local_map.hpp"
+#include "jeep/options.hpp"
 #include "jeep/scan_preparation.hpp"
 #include "ulc/core/lie.hpp"
 #include "ulc/core/point_to_plane.hpp"
@@ -42,44 +43,6 @@ namespace jeep {
 using ulc::RegistrationOptions;
 using ulc::RegistrationStatus;
 using ulc::Vec6d;
-
-struct OdometryOptions {
-  ScanOptions scan;
-  LocalMapOptions map;
-  /// m, gate of the first registration stage (the second uses half of it). With
-  /// single_stage, frames after the velocity is known get the second stage only.
-  double gate = 2.0;
-  double initial_gate = 3.0;   ///< m, first-stage gate while the velocity is unknown
-  double coarse_kernel = 0.2;  ///< m, Geman-McClure scale of the first stage
-  double fine_kernel = 0.05;   ///< m, of the second stage
-  /// Off by default: the fine stage alone (Geman-McClure 5 cm) ignores the right planes once
-  /// the constant-velocity prediction is a few decimetres off, e.g. when the vehicle brakes
-  /// or accelerates; the next prediction is then worse and the odometry runs away (60 s 64-32
-  /// drives, seeds 1-3: ATE 19-40 m with it, 0.17-0.37 m without, at the same speed;
-  /// docs/BENCHMARKS.md). JEEP's later rounds use it: they start from settled poses.
-  bool single_stage = false;
-  int max_iterations = 30;              ///< correspondence searches per stage
-  double translation_tolerance = 5e-4;  ///< m, second stage (the first: 1e-3)
-  double rotation_tolerance = 5e-5;     ///< rad, second stage (the first: 1e-4)
-  double target_weight = 1.0;           ///< weight of b's residuals against a's
-  double time_offset_s = 0.0;           ///< t_base_clock = t_target_clock + time_offset_s
-  double max_pair_gap = 0.5;            ///< in base frame periods
-  std::size_t min_correspondences = 30;
-  double min_condition = 1e-3;  ///< registration_conditioning.hpp
-};
-
-/// The pose phase inside JEEP: denser scans (the calibration phase maps them), both stages
-/// always, tighter tolerances; a handful of frames, so speed matters less than in odometry.
-inline OdometryOptions jeep_pose_phase_options() {
-  OdometryOptions o;
-  o.scan.map_voxel = 0.4;
-  o.scan.registration_voxel = 0.75;
-  o.map.min_point_distance = 0.3;
-  o.single_stage = false;
-  o.translation_tolerance = 1e-4;
-  o.rotation_tolerance = 1e-5;
-  return o;
-}
 
 inline bool valid_odometry_options(const OdometryOptions& o) {
   return valid_scan_options(o.scan) && valid_local_map_options(o.map) && o.gate > 0.0 &&

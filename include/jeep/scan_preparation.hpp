@@ -17,6 +17,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "jeep/options.hpp"
 #include "ulc/core/cloud.hpp"
 #include "ulc/core/deskew.hpp"
 #include "ulc/core/lie.hpp"
@@ -26,14 +27,6 @@
 #include "ulc/core/voxel_downsample.hpp"
 
 namespace jeep {
-
-struct ScanOptions {
-  double min_range = 2.0;           ///< m
-  double max_range = 100.0;         ///< m
-  double map_voxel = 0.5;           ///< m, resolution of the dense points
-  double registration_voxel = 1.0;  ///< m, resolution of the sparse points
-  bool deskew = true;
-};
 
 inline bool valid_scan_options(const ScanOptions& o) {
   return o.min_range >= 0.0 && o.max_range > o.min_range && o.map_voxel > 0.0 &&

@@ -12,22 +12,12 @@
 
 #include "jeep/acceptance.hpp"
 #include "jeep/map_registration.hpp"
+#include "jeep/options.hpp"
 #include "jeep/scan_preparation.hpp"
 #include "ulc/core/point_traits.hpp"
 #include "ulc/core/types.hpp"
 
 namespace jeep {
-
-struct ScanScanOptions {
-  ScanOptions scan = [] {
-    ScanOptions o;
-    o.map_voxel = 0.25;
-    o.deskew = false;
-    return o;
-  }();
-  MapRegistrationOptions registration = default_map_registration();
-  AcceptanceOptions acceptance;
-};
 
 enum class ScanScanStatus { ok, rejected, registration_failed, invalid_input };
 

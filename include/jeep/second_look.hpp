@@ -39,22 +39,13 @@
 
 #include "jeep/acceptance.hpp"
 #include "jeep/map_registration.hpp"
+#include "jeep/options.hpp"
 #include "jeep/start_search.hpp"
 #include "jeep/two_way.hpp"
 #include "ulc/core/lie.hpp"
 #include "ulc/core/types.hpp"
 
 namespace jeep {
-
-struct SecondLookOptions {
-  bool enabled = false;                  ///< opt-in: see "Measured" at the top
-  double min_off_ground_overlap = 0.10;  ///< below: no second look
-  double max_gap_translation = 0.02;     ///< m
-  double max_gap_rotation = 0.1 * 3.14159265358979323846 / 180.0;  ///< rad
-  std::size_t min_returned = 10;                                   ///< of the twelve starts
-  double return_translation = 0.01;                                ///< m
-  double return_rotation = 0.05 * 3.14159265358979323846 / 180.0;  ///< rad
-};
 
 struct SecondLookReport {
   bool ran = false;     ///< the acceptance's refusal qualified for a second look

@@ -32,23 +32,12 @@
 #include <vector>
 
 #include "jeep/map_registration.hpp"
+#include "jeep/options.hpp"
 #include "ulc/core/lie.hpp"
 #include "ulc/core/point_to_plane.hpp"
 #include "ulc/core/types.hpp"
 
 namespace jeep {
-
-struct StartSearchOptions {
-  bool enabled = true;
-  double rotation_step = 5.0 * 3.14159265358979323846 / 180.0;  ///< rad, the paper's disturbance
-  double translation_step = 2.0;                                ///< m, the paper's disturbance
-  double same_basin_rotation = 1.0 * 3.14159265358979323846 / 180.0;  ///< rad
-  double same_basin_translation = 0.3;                                ///< m
-  /// Basins further than this from the initial extrinsic are not candidates: the initial
-  /// guess is trusted to within twice the paper's disturbance.
-  double reach_rotation = 10.0 * 3.14159265358979323846 / 180.0;  ///< rad
-  double reach_translation = 5.0;                                 ///< m
-};
 
 /// What the search did (zeros when it did not run).
 struct StartSearchReport {

@@ -3,7 +3,9 @@
 // bags other tools wrote exactly as their README says; `ulc export` writes the frames back;
 // topics that are missing or not clouds, and damaged files, are one clear line and exit 2;
 // LiDAR names never collide into an error.
+#include <unistd.h>
 #include <algorithm>
+
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <filesystem>
@@ -29,7 +31,9 @@ namespace {
 /// A 0.6 s 64-32 drive and the same drive as every kind of recording, removed afterwards.
 struct BagDrive {
   fs::path dir;
-  BagDrive() : dir(fs::temp_directory_path() / "ulc_test_cli_bags") {
+  // One folder per process: CTest runs the test cases as parallel processes.
+  BagDrive()
+      : dir(fs::temp_directory_path() / ("ulc_test_cli_bags_" + std::to_string(::getpid()))) {
     fs::remove_all(dir);
     const auto run = run_command(kUlc + " simulate --quiet --scenario 64-32 --seconds 0.6 " +
                                  "--seed 3 --out " + quote((dir / "folders").string()));

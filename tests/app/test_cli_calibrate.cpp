@@ -1,5 +1,5 @@
 // `ulc calibrate` end to end: on a tiny simulated 64-32 dataset (written by `ulc simulate`),
-// --stages terra writes the result file of DESIGN.md with a rotation near the ground truth;
+// --stages terra writes the result file of docs/design.md with a rotation near the ground truth;
 // terra,jeep passes `ulc evaluate`; jeep alone takes --initial as numbers or as a result file;
 // --stages hots is accepted and runs over every frame, and --synced-clocks skips the offset;
 // a target that cannot be calibrated gives exit code 1 and still its entry; bad usage gives exit
@@ -79,7 +79,8 @@ bool evaluate_success(const Dataset& d, const std::string& result) {
 
 }  // namespace
 
-TEST_CASE("ulc calibrate --stages terra writes the result file of DESIGN.md", "[app][calibrate]") {
+TEST_CASE("ulc calibrate --stages terra writes the result file of docs/design.md",
+          "[app][calibrate]") {
   const Dataset d("ulc_test_calibrate_terra");
   const std::string out = d.file("result.json");
   const auto run = run_command(kUlc + " calibrate" + d.pair_args() +
@@ -101,7 +102,7 @@ TEST_CASE("ulc calibrate --stages terra writes the result file of DESIGN.md", "[
   INFO("e_rot " << e.rotation_deg << " deg");
   CHECK(ulc::is_rotation_init_success(e));
 
-  // Every field of DESIGN.md, in its spelling.
+  // Every field of docs/design.md, in its spelling.
   const auto doc = ulc::io::read_json_file(out);
   const auto& entry = doc.at("results")[0];
   for (const char* key :
@@ -340,7 +341,7 @@ TEST_CASE("ulc calibrate reports bad usage and unreadable input with exit code 2
   usage(d.pair_args() + " --stages jeep,terra", "cannot follow");
   usage(d.pair_args() + " --stages jeep", "needs an initial extrinsic");
   usage(d.pair_args() + " --stages terra --initial '0 0 0 0 0 0'", "'--initial' is only used");
-  usage(d.pair_args() + " --frame-index 6", "--frame-index 6 is past the end of");
+  usage(d.pair_args() + " --frame-index 6", "--frame-index 6 is past the last frame of");
   usage(d.pair_args() + " --frame-index -1", "'--frame-index' must be within");
   usage(d.pair_args() + " --frames 0", "'--frames' must be within");
   usage(d.pair_args() + " --threads 0", "'--threads' must be within");

@@ -25,7 +25,7 @@ std::string read_all(const fs::path& p) {
 
 }  // namespace
 
-TEST_CASE("ulc simulate writes the dataset folder of DESIGN.md", "[app][simulate]") {
+TEST_CASE("ulc simulate writes the dataset folder of docs/design.md", "[app][simulate]") {
   const fs::path dir = fs::temp_directory_path() / "ulc_test_simulate";
   fs::remove_all(dir);
   const auto run = run_command(kUlc + " simulate --scenario 64-32 --seconds 0.25 --seed 3 --out " +

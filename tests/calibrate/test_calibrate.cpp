@@ -1,6 +1,6 @@
 // ulc::calibrate_pair: TERRA then JEEP recover the 64-32 mounting with no guess, JEEP alone
 // refines a disturbed guess, every refusal comes back as a status (never a crash), results are
-// bit-identical for 1 and 2 threads, and the result-file entry carries what DESIGN.md lists.
+// bit-identical for 1 and 2 threads, and the result-file entry carries what docs/design.md lists.
 #include <tbb/task_arena.h>
 #include <catch2/catch.hpp>
 #include <string>
@@ -209,7 +209,7 @@ TEST_CASE("calibrate_pair gives the same bits on 1 and 2 threads", "[calibrate][
   CHECK(same_bits(r1.T_base_target, r2.T_base_target));
 }
 
-TEST_CASE("the result-file entry has the fields of DESIGN.md", "[calibrate][result]") {
+TEST_CASE("the result-file entry has the fields of docs/design.md", "[calibrate][result]") {
   ulc::CalibrateOptions o;
   o.stages = {Stage::terra};
   const auto c = ulc::calibrate_pair(base().frames, base().timestamps, target().frames,

@@ -1,6 +1,6 @@
 // Named scenarios and rigs: every required name exists and is valid, mounts are realistic
 // (0.5..3 m apart, non-trivial rotations, outside the body), pair truths follow from the mounts,
-// and clock offsets follow the DESIGN.md convention.
+// and clock offsets follow the docs/design.md convention.
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>

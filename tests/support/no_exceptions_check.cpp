@@ -1,4 +1,4 @@
-// Compiled with -fno-exceptions: every algorithm header must build this way (DESIGN.md).
+// Compiled with -fno-exceptions: every algorithm header must build this way (docs/design.md).
 // Add each new algorithm header here.
 #include "hots/hots.hpp"
 #include "jeep/jeep.hpp"
@@ -6,6 +6,7 @@
 #include "jeep/scan_scan.hpp"
 #include "terra/terra.hpp"
 #include "ulc/calibrate.hpp"
+#include "ulc/calibrate/pipeline.hpp"
 #include "ulc/calibrate/rig.hpp"
 #include "ulc/core/cloud.hpp"
 #include "ulc/core/kdtree.hpp"
@@ -26,11 +27,10 @@ template ulc::NormalsResult<float> ulc::estimate_normals(const ulc::PointCloud<f
 template ulc::VoxelDownsampleResult<double> ulc::voxel_downsample(const ulc::PointCloud<double>&,
                                                                   double);
 template ulc::Vec3<double> ulc::so3_log(const Eigen::MatrixBase<ulc::Mat3<double>>&);
-template ulc::PairCalibration ulc::calibrate_pair(const std::vector<ulc::PointCloud<float>>&,
-                                                  const std::vector<double>&,
-                                                  const std::vector<ulc::PointCloud<float>>&,
-                                                  const std::vector<double>&,
-                                                  const ulc::CalibrateOptions&);
+template ulc::PairCalibration ulc::calibrate_pair_in_place(
+    const std::vector<ulc::PointCloud<float>>&, const std::vector<double>&,
+    const std::vector<ulc::PointCloud<float>>&, const std::vector<double>&,
+    const ulc::CalibrateOptions&);
 template ulc::RigCalibration ulc::calibrate_rig(
     const std::vector<ulc::RigLidar<std::vector<ulc::PointCloud<float>>>>&, std::size_t,
     const ulc::RigOptions&);

@@ -57,7 +57,7 @@ TEST_CASE("search finds known rotations of the scene, large ones included", "[se
 
 TEST_CASE("search succeeds on a re-scanned, shifted target LiDAR", "[search]") {
   // A second LiDAR with its own scan pattern, turned and 0.4 m away: no exact match exists,
-  // and a rotation initialisation succeeds below 10 deg (DESIGN.md).
+  // and a rotation initialisation succeeds below 10 deg (docs/design.md).
   const terra::Lattice lattice(10000);
   const auto base = terra_test::scan(ulc::Mat3d::Identity());
   terra::SplitMix64 rng(17);

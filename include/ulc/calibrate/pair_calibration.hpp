@@ -1,7 +1,8 @@
-// What calibrate_pair (ulc/calibrate.hpp) returns for one base/target pair.
+// What calibrate_pair (ulc/calibrate.hpp) returns for one base/target pair. Light: it includes
+// no algorithm, so that a file calling the pipeline compiles in seconds.
 //
 // Conventions this header owns:
-//   - T_base_target maps target points into the base frame (DESIGN.md): p_base = T * p_target.
+//   - T_base_target maps target points into the base frame (docs/design.md): p_base = T * p_target.
 //   - On success it is the last stage's output. On failure it is the input of the stage that
 //     failed (TERRA's rotation or the initial guess; identity when TERRA failed), kept for
 //     inspection only: `success` false means "do not use it".
@@ -19,9 +20,9 @@
 #include <utility>
 #include <vector>
 
-#include "hots/hots.hpp"
+#include "hots/refine_statistics.hpp"
 #include "terra/search_params.hpp"
-#include "ulc/calibrate/map_terra.hpp"
+#include "ulc/calibrate/map_terra_options.hpp"
 #include "ulc/calibrate/stages.hpp"
 #include "ulc/core/types.hpp"
 

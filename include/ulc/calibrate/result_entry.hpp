@@ -1,11 +1,11 @@
-// A PairCalibration as the result file's entry (DESIGN.md, "Result file"; io/result_file.hpp).
+// A PairCalibration as the result file's entry (docs/design.md, "Result file"; io/result_file.hpp).
 //
 // Conventions this header owns:
 //   - time_offset_s is the caller's known offset or HOTS's when it succeeded, otherwise 0
 //     (clocks assumed synchronised); covariance_6x6 is HOTS's, null without it.
 //   - "stages" holds one object per stage that ran ("terra", "jeep", "hots"); "timing_s" always
 //   holds
-//     every stage key of DESIGN.md ("terra", "jeep", "odometry", "hots", "total"), 0 for a
+//     every stage key of docs/design.md ("terra", "jeep", "odometry", "hots", "total"), 0 for a
 //     stage that did not run.
 //   - Angles in the stage objects are degrees, distances metres, times seconds.
 // This is an I/O-side header (it builds ulc::io::Json): unlike ulc/calibrate.hpp it is not part

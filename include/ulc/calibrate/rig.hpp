@@ -293,7 +293,7 @@ RigCalibration calibrate_rig(const std::vector<RigLidar<Frames>>& lidars, std::s
     for (const RigTarget& t : rig.targets)
       if (!t.ok()) rig.reason += " " + t.name;
   }
-  rig.seconds = calibrate_detail::seconds_since(start);
+  rig.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return rig;
 }
 

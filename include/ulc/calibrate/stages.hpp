@@ -1,7 +1,7 @@
 // The stages of the calibration pipeline and the text form users type ("terra,jeep").
 //
 // Conventions this header owns:
-//   - Stages always run in pipeline order: terra -> jeep -> hots (DESIGN.md, "The house").
+//   - Stages always run in pipeline order: terra -> jeep -> hots (docs/design.md, "The house").
 //     A stage list names each stage at most once, in that order; parse_stages says why a list
 //     is not usable instead of reordering it silently.
 //   - stage_available() says whether this build can run a stage (all three can now; it stays

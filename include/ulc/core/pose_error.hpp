@@ -1,4 +1,4 @@
-// Errors of an estimated pose against a reference, as the paper reports them (DESIGN.md):
+// Errors of an estimated pose against a reference, as the paper reports them (docs/design.md):
 //   e_rot   = arccos((trace(R_gt^T R) - 1) / 2)     (the angle of the relative rotation)
 //   e_trans = |t - t_gt|
 // and the paper's success thresholds. The angle is computed as atan2(|skew part|, trace part)

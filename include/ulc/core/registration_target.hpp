@@ -28,12 +28,6 @@
 
 namespace ulc {
 
-struct PlaneCloudOptions {
-  std::size_t normal_k = 10;   ///< neighbours of the PCA
-  double min_planarity = 0.5;  ///< (l2 - l1) / l2, normals.hpp
-  bool use_cloud_normals = true;
-};
-
 namespace detail {
 
 /// nanoflann result set: the nearest point with squared distance <= a bound (ties: lower

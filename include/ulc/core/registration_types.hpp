@@ -100,4 +100,11 @@ struct RegistrationResult {
   }
 };
 
+/// How a PlaneCloud (registration_target.hpp) finds its points' planes.
+struct PlaneCloudOptions {
+  std::size_t normal_k = 10;   ///< neighbours of the PCA
+  double min_planarity = 0.5;  ///< (l2 - l1) / l2, normals.hpp
+  bool use_cloud_normals = true;
+};
+
 }  // namespace ulc

@@ -1,4 +1,4 @@
-// ground_truth.json of a dataset folder (DESIGN.md): per LiDAR its model and T_vehicle_lidar,
+// ground_truth.json of a dataset folder (docs/design.md): per LiDAR its model and T_vehicle_lidar,
 // per pair T_base_target and the clock offset (t_base_clock = t_target_clock + time_offset_s).
 #pragma once
 

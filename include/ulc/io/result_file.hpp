@@ -1,4 +1,4 @@
-// The calibration result file of DESIGN.md ("Result file"): one entry per target LiDAR inside
+// The calibration result file of docs/design.md ("Result file"): one entry per target LiDAR inside
 // "results", each with the transform in four spellings (matrix, translation, quaternion wxyz,
 // roll/pitch/yaw in degrees with R = Rz(yaw) Ry(pitch) Rx(roll)), the clock offset, a 6x6
 // covariance, per-stage statistics and timings. A failed calibration still has its entry, with

@@ -1,7 +1,7 @@
 // The result file as YAML (`ulc calibrate --format yaml`): per target, the extrinsic in every
 // form a robotics engineer pastes somewhere else.
 //
-// Conventions: T_base_target maps target points into the base frame (DESIGN.md). In ROS terms
+// Conventions: T_base_target maps target points into the base frame (docs/design.md). In ROS terms
 // the base LiDAR is the parent frame and the target the child, so
 //   - static_transform_publisher (ROS 1 tf / tf2_ros) takes "x y z yaw pitch roll parent child"
 //     with angles in radians;

@@ -1,4 +1,4 @@
-// Sequence: the frames of one LiDAR, as laid out in a dataset folder (DESIGN.md):
+// Sequence: the frames of one LiDAR, as laid out in a dataset folder (docs/design.md):
 //
 //   DIR/<lidar>/000000.pcd 000001.pcd ...   frames (.pcd, .ply, .bin), sorted by plain file name
 //   DIR/<lidar>/timestamps.txt              optional: one frame start time per line, seconds
@@ -17,10 +17,10 @@
 //      seconds) or an integer stem >= 1e17 (Unix nanoseconds). Zero-padded indices such as
 //      "000042" are frame numbers, not times.
 //   4. Otherwise 10 Hz: frame i at i * 0.1 s.
-// Per-point times: load_frame returns them relative to the frame timestamp (DESIGN.md). Absolute
-// per-point times are shifted by the frame timestamp; with timestamps.txt they must then lie
-// within kMaxPointTimeGap of it (else the two clocks differ and the data are rejected). Relative
-// per-point times are returned as stored.
+// Per-point times: load_frame returns them relative to the frame timestamp (docs/design.md).
+// Absolute per-point times are shifted by the frame timestamp; with timestamps.txt they must then
+// lie within kMaxPointTimeGap of it (else the two clocks differ and the data are rejected).
+// Relative per-point times are returned as stored.
 #pragma once
 
 #include <algorithm>

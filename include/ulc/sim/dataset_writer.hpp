@@ -1,4 +1,4 @@
-// Writing a simulated dataset as the dataset folder of DESIGN.md. This is I/O: failures throw
+// Writing a simulated dataset as the dataset folder of docs/design.md. This is I/O: failures throw
 // ulc::io::IoError (file, position, reason), the I/O layer's one exception type.
 //
 // Layout written (and nothing else):

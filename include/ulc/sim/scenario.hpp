@@ -5,7 +5,7 @@
 //   - T_vehicle_lidar maps LiDAR-frame points into the vehicle frame (vehicle.hpp). For a pair,
 //     T_base_target = T_vehicle_base^-1 T_vehicle_target (p_base = T_base_target p_target).
 //   - Clocks: each LiDAR's clock reads t_own = t_true - clock_offset_s (t_true is the
-//     trajectory's time). A pair's offset in the DESIGN.md convention
+//     trajectory's time). A pair's offset in the docs/design.md convention
 //     t_base_clock = t_target_clock + time_offset_s is therefore
 //     time_offset_s = clock_offset(target) - clock_offset(base).
 //   - The first LiDAR of a scenario is the base of its default pairs; pair scenarios are

@@ -10,7 +10,7 @@
 //   options.seconds = 20;
 //   // In memory (frames in result.dataset.lidars[i].frames):
 //   ulc::sim::SimulationResult r = ulc::sim::simulate(*spec, options);
-//   // Or streamed to a dataset folder (DESIGN.md layout), bounded memory:
+//   // Or streamed to a dataset folder (docs/design.md layout), bounded memory:
 //   r = ulc::sim::simulate_to_directory("out/64-32", *spec, options, progress);
 //
 // Map of the headers (each states the conventions it owns at its top):
