@@ -18,7 +18,8 @@
 //     points without a partner and can fail CrossLinkOptions::min_inlier_ratio (60 s 64-32:
 //     4-6 of 8 boundaries registered). A 40 m crop registered all 8 but did not make the
 //     trajectory better (best-aligned ATE, seeds 1-3: 2.06 / 3.96 / 2.43 cm whole, 1.94 /
-//     5.28 / 2.60 cm cropped; docs/BENCHMARKS.md, session 9), so the default is no crop.
+//     5.28 / 2.60 cm cropped; docs/BENCHMARKS.md, "Top-layer boundaries registered"), so the
+//     default is no crop.
 //   - Boundaries marked in `skip` (those a bridge BA already ties, boundary_bridges.hpp) are
 //     not registered.
 //   - A boundary whose registration is unusable (empty submaps at the ends, too few inliers)

@@ -22,7 +22,7 @@
 //     agree_rotation_rad and agree_translation_m from its start (CrossLink::moved_*): the start
 //     is the prediction of the odometry's poses and the current extrinsic, good to a few
 //     centimetres and a tenth of a degree when the extrinsic is right. Measured on the
-//     seven-LiDAR rig's Tele (60 s, session 9): from the true extrinsic 35 of its 50 kept links
+//     seven-LiDAR rig's Tele (60 s): from the true extrinsic 35 of its 50 kept links
 //     moved less than 1 deg and 1 m (the rest converged elsewhere in the narrow cone, 1.4-8.4
 //     deg); from the wrong one JEEP accepted (11.3 deg / 5.2 m off) all 27 kept links moved
 //     1.6-14.8 deg, none agreed. hots.hpp's trust rule counts agreeing links.

@@ -30,8 +30,8 @@
 //     min_off_ground_overlap, directional overlap >= min_directional_overlap (a floor) and
 //     condition >= min_condition. `overlap` is reported (and orders a rig's routes), not judged.
 //   - Why the directional overlap: two maps of unrelated places, registered, agree on the
-//     ground and on whatever wall happens to coincide; their plain overlap (the former rule,
-//     accepted at 0.6) reached 0.71 on 64-horizon and 0.89 with a Tele (bench_jeep
+//     ground and on whatever wall happens to coincide; their plain overlap (accepted at 0.6 by
+//     a plain-overlap rule) reached 0.71 on 64-horizon and 0.89 with a Tele (bench_jeep
 //     --separation, seeds 1-3, 2026-11-23), as high as at the truth on sparse maps (VLP-16,
 //     Avia: 0.59-0.75), where edges and occlusion borders disagree. But the agreement of
 //     unrelated maps sits in the ground's three directions; along the road, across it or in
@@ -40,7 +40,7 @@
 //     saw). 0.25 was chosen on seeds 2 and 3, not on the accuracy drives (docs/BENCHMARKS.md,
 //     "The acceptance rule's directional overlap"): it accepted 2 of 85 unrelated pairs without
 //     a Tele and 2 of 27 with one, where overlap >= 0.6 accepted 21 and 22.
-//   - Why off the ground (session 17): any two roads agree in the ground's three directions,
+//   - Why off the ground: any two roads agree in the ground's three directions,
 //     so they tell nothing about a coincidence, and on sparse pairs they were what refused
 //     right answers: a VLP-32C's planes between its far rings are extrapolated, and 70-77 % of
 //     a Livox Avia's near ground points lie more than 10 cm from them at the truth, which made

@@ -27,7 +27,7 @@
 //     from 86 % to 88 %, but one of 48 unrelated 32-16 pairs is accepted too (two-way gap
 //     1.9 cm, 11 of 12 starts back). Hence opt-in: on a rig whose LiDARs record the same
 //     street at the same time, "unrelated" data cannot occur and the trade is worth it.
-//     Those figures are of the six-direction rule. Since session 17 the acceptance judges the
+//     Those figures are of the six-direction rule. Now that the acceptance judges the
 //     directions off the ground, which accepts those sparse pairs' right answers itself
 //     (32-16 and 32-avia 100 %); with it the second look changes no figure of the accuracy
 //     drives, and it stays for what the new rule still refuses.

@@ -58,10 +58,10 @@ ulc::RigOptions terra_jeep() {
 
 TEST_CASE("a three-LiDAR rig: every target within 0.5 deg and 5 cm, the cycle closes",
           "[calibrate][rig]") {
-  // Three spinning LiDARs of the seven-LiDAR rig. (Until session 12 this was three VLP-16s of
-  // the ring, 90 deg apart; JEEP's acceptance of session 12 refused their corner-to-corner
-  // pairs on 0.6 s of data: the directional overlap was 0.16-0.22 there, below its 0.25,
-  // acceptance.hpp. The ring itself is bench_rig's, with HOTS, which calibrates every target.)
+  // Three spinning LiDARs of the seven-LiDAR rig. (Not the ring's three VLP-16s, 90 deg apart:
+  // JEEP's acceptance refuses their corner-to-corner pairs on 0.6 s of data, the directional
+  // overlap being 0.16-0.22 there, below its 0.25, acceptance.hpp. The ring itself is
+  // bench_rig's, with HOTS, which calibrates every target.)
   const ulc::sim::Dataset d = short_rig("colorful", {"lidar64", "lidar32", "lidar16"});
   // Double clouds with point times (the float path is the routing test's).
   std::vector<std::vector<ulc::PointCloud<double>>> frames;

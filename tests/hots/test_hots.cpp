@@ -188,7 +188,7 @@ TEST_CASE("an extrinsic the LiDARs' views do not confirm is refused", "[hots][re
   const hots::RefineResult unchecked =
       hots::refine(a.frames, a.timestamps, pa, b.frames, b.timestamps, pb, wrong, options);
   CHECK(unchecked.status != hots::RefineStatus::extrinsic_unconfirmed);
-  // ... and the graph, with no link to hold the extrinsic, misses issue 7's bar (0.1 deg, 2 cm)
+  // ... and the graph, with no link to hold the extrinsic, misses the rig bar (0.1 deg, 2 cm)
   // by far. (The whole-sequence step after it may still find the truth from there: on this
   // drive it does with two sweep parts, 0.003 deg / 0.2 cm, not with rigid frames, 0.27 deg /
   // 2 m; nothing in the run tells which, so the refusal stands.)

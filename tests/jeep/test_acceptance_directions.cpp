@@ -92,7 +92,7 @@ TEST_CASE("acceptance refuses maps that agree on the ground but not on their wal
   const Points b = corner(10.5, 8.5, 0.1, rng);
   const auto r = judge(a, b);
   INFO(evidence(r));
-  // The former rule (overlap >= 0.6, condition >= min_condition) would have accepted.
+  // A plain-overlap rule (overlap >= 0.6, condition >= min_condition) would have accepted.
   CHECK(r.overlap > 0.6);
   CHECK(r.condition >= jeep::AcceptanceOptions{}.min_condition);
   CHECK(r.off_ground_overlap < jeep::AcceptanceOptions{}.min_off_ground_overlap);

@@ -84,7 +84,7 @@ TEST_CASE("multi-LiDAR odometry gives both LiDARs' poses in their own map frames
   INFO("a: " << ea.rotation_deg << " deg, " << ea.translation_m << " m; b: " << eb.rotation_deg
              << " deg, " << eb.translation_m << " m");
   // Worst frame of a 1 s drive with a quarter of the columns: 0.1005 deg with the default
-  // coarse-then-fine steps (session 7; the fine stage alone stayed just under 0.1).
+  // coarse-then-fine steps (the fine stage alone stayed just under 0.1).
   CHECK(ea.rotation_deg < 0.15);
   CHECK(ea.translation_m < 0.03);
   CHECK(eb.rotation_deg < 0.15);

@@ -70,7 +70,7 @@ const ulc::sim::Dataset& tele_drive() {
     spec.scenario = "64-tele";
     spec.start_s = 2.0;
     spec.seconds = spec.start_s + 0.6;
-    // Full rate: decimated 4x (as before session 12) its right answers have a directional
+    // Full rate: decimated 4x (as the odometry once did) its right answers have a directional
     // overlap of 0.19, below the acceptance rule's 0.25 (acceptance.hpp).
     spec.decimation = 1;
     return simulate(spec);

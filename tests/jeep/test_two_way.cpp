@@ -87,7 +87,7 @@ TEST_CASE("single-frame JEEP with base and target swapped gives the inverse", "[
   CHECK(e.translation_m < 0.02);
   // Both runs find the same two minima and meet at inverse points: the cycle is the
   // registration tolerances (1e-4 m, 1e-5 rad), not the directions' gap a one-way answer
-  // would leave. Issue 7's bar is 0.02 deg and 5 mm.
+  // would leave. The rig accuracy bar is 0.02 deg and 5 mm.
   CHECK(cycle_t < 0.005);
   CHECK(cycle_r < 0.02 * kDeg);
   CHECK(cycle_t < 0.25 * gap_t + 3e-4);

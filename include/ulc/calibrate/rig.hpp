@@ -1,6 +1,6 @@
 // A rig of N LiDARs, one of them the base: every other LiDAR (a target) calibrated against the
 // base, routed through another LiDAR when the direct attempt fails, and the cycles between
-// targets closed to show how well the extrinsics agree (issue 7, "N LiDARs").
+// targets closed to show how well the extrinsics agree.
 //
 // Conventions this header owns:
 //   - Input: RigLidar views (name, frames, timestamps, optional guess); the frames and times

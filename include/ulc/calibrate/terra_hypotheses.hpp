@@ -4,7 +4,7 @@
 // Why: on small-FoV pairs (a Tele-15 against a spinning LiDAR) the lowest eq:feature_dis is
 // often not the true rotation but the street's forward/backward twin (~166 deg of yaw) or a
 // neighbouring basin, while the true one is the search's second or third optimum (the
-// colorful rig's Tele, session 10: rank 1, 2, 2 and 1 in four drives). The search already
+// colorful rig's Tele: rank 1, 2, 2 and 1 in four drives). The search already
 // descends from top_k stage-1 seeds (search.hpp, stage 2); this keeps its optima, drops those
 // within `separation_rad` of a better one (the same basin: JEEP converges from a few degrees),
 // and orders them by (distance, seed rank), the search's own choice rule, so the first is
