@@ -2,6 +2,8 @@
 // writers come back through open_recording and CloudTopic with their stamps, points and
 // per-point times; the receive time can be the frame time; a missing or non-cloud topic is an
 // error naming the point-cloud topics.
+#include <unistd.h>
+
 #include <catch2/catch.hpp>
 #include <filesystem>
 #include <string>
@@ -49,8 +51,9 @@ void write_recording(const fs::path& path, RecordingKind kind) {
   w.close();
 }
 
+/// One folder per process: CTest runs the test cases as parallel processes.
 struct Scratch {
-  fs::path dir = fs::temp_directory_path() / "ulc_test_cloud_topic";
+  fs::path dir = fs::temp_directory_path() / ("ulc_test_cloud_topic_" + std::to_string(::getpid()));
   Scratch() {
     fs::remove_all(dir);
     fs::create_directories(dir);

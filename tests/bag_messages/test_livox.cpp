@@ -1,5 +1,6 @@
 // Livox CustomMsg (livox_ros_driver and livox_ros_driver2) in both serialisations.
 #include <catch2/catch.hpp>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -66,6 +67,16 @@ TEST_CASE("Livox CustomMsg: a timebase after the stamp shifts the times; lies ar
                                 ulc::bags::Serialization::ros1, "livox_ros_driver/CustomMsg");
   REQUIRE(msg.cloud.times[0] == Approx(0.002).margin(1e-12));
   REQUIRE(msg.cloud.times[1] == Approx(0.012).margin(1e-12));
+
+  // A timebase in another clock (here the largest uint64) is not related to the stamp: the
+  // offsets count from the stamp, and the time field says so.
+  auto foreign = m;
+  foreign.timebase = std::numeric_limits<std::uint64_t>::max();
+  const auto far = decode_livox_bytes(
+      ulc::bags::write_livox_custom(foreign, ulc::bags::Serialization::ros1),
+      ulc::bags::Serialization::ros1, "livox_ros_driver/CustomMsg");
+  REQUIRE(far.cloud.times[1] == Approx(0.01).margin(1e-12));
+  REQUIRE_THAT(ulc::bags::describe(far.time), Catch::Contains("another clock"));
 
   auto bytes = ulc::bags::write_livox_custom(m, ulc::bags::Serialization::ros1);
   // point_num sits after seq 4, stamp 8, frame_id 4 + 1, timebase 8 = byte 25.

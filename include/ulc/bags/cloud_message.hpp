@@ -122,11 +122,15 @@ inline CloudMessage decode_livox(MessageReader& in, Serialization serialization)
   // offset_time counts from timebase: as nanoseconds relative to the stamp they stay exact. A
   // timebase in another clock than the stamp (seconds away) cannot be related to it: the
   // offsets are then taken from the stamp, and the note says so.
-  double base_ns = static_cast<double>(static_cast<std::int64_t>(m.timebase) - m.header.stamp_ns);
-  if (std::abs(base_ns) > kMaxSweepSeconds * 1e9) {
-    out.time.note = "timebase is " + std::to_string(base_ns * 1e-9) +
+  // The gap is first taken in double: a corrupted or foreign timebase (any uint64) must not
+  // overflow; within the sweep limit both values are small enough to subtract exactly.
+  const double gap_ns = static_cast<double>(m.timebase) - static_cast<double>(m.header.stamp_ns);
+  double base_ns = 0.0;
+  if (std::abs(gap_ns) > kMaxSweepSeconds * 1e9) {
+    out.time.note = "timebase is " + std::to_string(gap_ns * 1e-9) +
                     " s from header.stamp (another clock): offsets taken from the stamp";
-    base_ns = 0.0;
+  } else {
+    base_ns = static_cast<double>(static_cast<std::int64_t>(m.timebase) - m.header.stamp_ns);
   }
   for (const LivoxPoint& p : m.points)
     builder.add(p.x, p.y, p.z, p.reflectivity, (base_ns + p.offset_time) * 1e-9);

@@ -275,7 +275,8 @@ class Rosbag2Sqlite : public MessageSource {
 /// Steps one prepared statement one row at a time; the view points into SQLite's row buffer.
 class Rosbag2Sqlite::Cursor : public MessageCursor {
  public:
-  Cursor(const Rosbag2Sqlite& bag, const std::string& id_list, TimeWindow window) : bag_(bag) {
+  Cursor(const Rosbag2Sqlite& bag, const std::string& id_list, TimeWindow window)
+      : bag_(bag), window_(window) {
     const bool inline_data = bag.sorted_by_index_;
     rows_ = sqlite_detail::prepare(bag.db_.get(), bag.file_, select_sql(id_list, inline_data));
     sqlite3_bind_int64(rows_.get(), 1, window.begin_ns);
@@ -298,6 +299,7 @@ class Rosbag2Sqlite::Cursor : public MessageCursor {
     if (topic == bag_.index_of_id_.end()) fail("its topic_id is not in the topics table");
     out.topic = topic->second;
     out.time_ns = sqlite3_column_int64(rows_.get(), 2);
+    check_order(out.time_ns);
     out.file = &bag_.file_;
     out.offset = 0;  // SQLite pages have no meaningful byte offset; errors cite the message id
     if (blob_ == nullptr) {
@@ -309,6 +311,20 @@ class Rosbag2Sqlite::Cursor : public MessageCursor {
   }
 
  private:
+  /// SQLite orders and filters by the timestamp index and returns the index's copy of the time:
+  /// a damaged index can disagree with the table. What comes out must still be in time order and
+  /// inside the window, or the file is damaged.
+  void check_order(std::int64_t t) {
+    if (!window_.contains(t))
+      fail("timestamp " + std::to_string(t) +
+           " outside the window asked for: the timestamp index disagrees with the messages "
+           "(a damaged file)");
+    if (previous_ns_ && t < *previous_ns_)
+      fail("timestamp " + std::to_string(t) + " comes after " + std::to_string(*previous_ns_) +
+           ": the timestamp index disagrees with the messages (a damaged file)");
+    previous_ns_ = t;
+  }
+
   /// `out` views the blob of `column`; valid until the statement steps or resets.
   void point_at_blob(sqlite3_stmt* s, int column, MessageView& out) const {
     static const unsigned char kEmpty[1] = {0};
@@ -340,6 +356,8 @@ class Rosbag2Sqlite::Cursor : public MessageCursor {
   sqlite_detail::Statement rows_;
   sqlite_detail::Statement blob_;
   std::optional<std::int64_t> last_id_;
+  TimeWindow window_;
+  std::optional<std::int64_t> previous_ns_;
 };
 
 namespace sqlite_detail {
