@@ -72,9 +72,9 @@ TEST_CASE("Livox CustomMsg: a timebase after the stamp shifts the times; lies ar
   // offsets count from the stamp, and the time field says so.
   auto foreign = m;
   foreign.timebase = std::numeric_limits<std::uint64_t>::max();
-  const auto far = decode_livox_bytes(
-      ulc::bags::write_livox_custom(foreign, ulc::bags::Serialization::ros1),
-      ulc::bags::Serialization::ros1, "livox_ros_driver/CustomMsg");
+  const auto far =
+      decode_livox_bytes(ulc::bags::write_livox_custom(foreign, ulc::bags::Serialization::ros1),
+                         ulc::bags::Serialization::ros1, "livox_ros_driver/CustomMsg");
   REQUIRE(far.cloud.times[1] == Approx(0.01).margin(1e-12));
   REQUIRE_THAT(ulc::bags::describe(far.time), Catch::Contains("another clock"));
 

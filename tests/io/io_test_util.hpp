@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "../support/temp_dir.hpp"
 #include "ulc/core/cloud.hpp"
 #include "ulc/io/io_error.hpp"
 
@@ -26,29 +27,32 @@ namespace io_test {
 namespace fs = std::filesystem;
 using Bytes = std::vector<unsigned char>;
 
-/// A fresh folder under the system temp dir, removed when the object dies. Unique per process
-/// and per object, so ctest can run test cases in parallel.
-class TempDir {
- public:
-  TempDir() {
-    static std::atomic<int> counter{0};
-    path_ = fs::temp_directory_path() /
-            ("ulc_io_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  const fs::path& path() const { return path_; }
-  fs::path operator/(const std::string& name) const { return path_ / name; }
-
- private:
-  fs::path path_;
+/// A fresh folder under the system temp dir (tests/support/temp_dir.hpp).
+struct TempDir : ulc_test::TempDir {
+  TempDir() : ulc_test::TempDir("ulc_io_test") {}
 };
+path_ = fs::temp_directory_path() /
+        ("ulc_io_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
+fs::remove_all(path_);
+fs::create_directories(path_);
+}
+~TempDir() {
+  std::error_code ec;
+  fs::remove_all(path_, ec);
+}
+TempDir(const TempDir&) = delete;
+TempDir& operator=(const TempDir&) = delete;
+const fs::path& path() const {
+  return path_;
+}
+fs::path operator/(const std::string& name) const {
+  return path_ / name;
+}
+
+private:
+fs::path path_;
+}
+;
 
 /// Appends raw values (host = little endian) or text.
 struct ByteBuilder {

@@ -149,8 +149,9 @@ TEST_CASE("real sample: croon_0003 calibrates top<-left and left<-top, and they 
                               << cycle.rotation_deg << " deg, " << cycle.translation_m << " m");
   CHECK(ulc::is_calibration_success(e_forward));  // CROON itself is good to ~0.2 deg, 5 cm
   CHECK(ulc::is_calibration_success(e_swapped));
-  // The rig accuracy bar (0.02 deg, 5 mm). One-way registration left 0.092 deg and 28 mm here (each direction fits its
-  // own target's points); JEEP's two-way step (two_way.hpp) meets the directions halfway.
+  // The rig accuracy bar (0.02 deg, 5 mm). One-way registration left 0.092 deg and 28 mm here (each
+  // direction fits its own target's points); JEEP's two-way step (two_way.hpp) meets the directions
+  // halfway.
   CHECK(cycle.rotation_deg < 0.02);
   CHECK(cycle.translation_m < 0.005);
 }

@@ -11,6 +11,7 @@
 
 #include <unistd.h>
 
+#include "../support/temp_dir.hpp"
 #include "test_paths.hpp"
 #include "ulc/bags/mcap_reader.hpp"
 #include "ulc/bags/mcap_writer.hpp"
@@ -24,18 +25,10 @@ using ulc::bags::McapWriteOptions;
 using ulc::bags::McapWriter;
 using ulc::bags::MessageView;
 
-struct Scratch {
-  fs::path path;
-  Scratch() {
-    path = fs::temp_directory_path() / ("ulc_test_mcap_robust_" + std::to_string(::getpid()));
-    fs::create_directories(path);
-  }
-  ~Scratch() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
+/// A fresh folder under the system temp dir (tests/support/temp_dir.hpp).
+struct Scratch : ulc_test::TempDir {
+  Scratch() : ulc_test::TempDir("ulc_test_mcap_robust") {}
 };
-
 /// Message i of the sample: 4 bytes of i, then (i % 23) * 3 bytes derived from i.
 std::vector<unsigned char> payload(std::uint32_t i) {
   std::vector<unsigned char> d(4 + (i % 23) * 3);
@@ -189,7 +182,7 @@ using namespace mcap_robust_test;
 
 TEST_CASE("mcap files cut at every byte: an IoError naming the file and a byte", "[mcap]") {
   Scratch dir;
-  const fs::path file = dir.path / "cut.mcap";
+  const fs::path file = dir / "cut.mcap";
   for (const Variant& v : variants()) {
     INFO(v.name);
     write_small(file, v.options);
@@ -211,7 +204,7 @@ TEST_CASE("mcap files cut at every byte: an IoError naming the file and a byte",
 
 TEST_CASE("mcap files with flipped bytes: success or an IoError", "[mcap]") {
   Scratch dir;
-  const fs::path file = dir.path / "flip.mcap";
+  const fs::path file = dir / "flip.mcap";
   for (const Variant& v : variants()) {
     INFO(v.name);
     write_small(file, v.options);
@@ -228,7 +221,7 @@ TEST_CASE("mcap files with flipped bytes: success or an IoError", "[mcap]") {
 
 TEST_CASE("mcap absurd lengths: an IoError, no allocation", "[mcap]") {
   Scratch dir;
-  const fs::path file = dir.path / "lengths.mcap";
+  const fs::path file = dir / "lengths.mcap";
   for (const Variant& v : variants()) {
     INFO(v.name);
     write_small(file, v.options);
@@ -294,7 +287,7 @@ TEST_CASE("mcap real files cut at every byte and flipped", "[mcap][shared]") {
   const fs::path bags = ulc_test::bags_dir();
   ULC_SKIP_UNLESS(!bags.empty(), "../shared/data/bags is absent");
   Scratch dir;
-  const fs::path file = dir.path / "real.mcap";
+  const fs::path file = dir / "real.mcap";
   for (const char* name : {"talker/talker.mcap", "cdr_test/cdr_test_0.mcap"}) {
     INFO(name);
     const auto clean = bytes_of(bags / "ros2" / "mcap" / name);

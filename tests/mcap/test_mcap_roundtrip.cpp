@@ -12,6 +12,7 @@
 
 #include <unistd.h>
 
+#include "../support/temp_dir.hpp"
 #include "ulc/bags/mcap_reader.hpp"
 #include "ulc/bags/mcap_writer.hpp"
 
@@ -25,18 +26,10 @@ using ulc::bags::McapWriter;
 using ulc::bags::MessageView;
 using ulc::bags::TimeWindow;
 
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    path = fs::temp_directory_path() / ("ulc_test_mcap_roundtrip_" + std::to_string(::getpid()));
-    fs::create_directories(path);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
+/// A fresh folder under the system temp dir (tests/support/temp_dir.hpp).
+struct TempDir : ulc_test::TempDir {
+  TempDir() : ulc_test::TempDir("ulc_test_mcap_roundtrip") {}
 };
-
 struct Written {
   std::string topic;
   std::int64_t time = 0;
@@ -191,7 +184,7 @@ TEST_CASE("mcap round trip: every message back in time order, counts and times",
         o.chunk_bytes = 2000;
         INFO("codec " << ulc::bags::codec_name(codec) << " summary " << summary << " chunked "
                       << chunked);
-        const fs::path file = dir.path / "sample.mcap";
+        const fs::path file = dir / "sample.mcap";
         const auto written = write_sample(file, o);
         McapReader r(file);
         CHECK(r.warnings().empty() == summary);
@@ -225,7 +218,7 @@ TEST_CASE("mcap round trip: selection by topic and time window", "[mcap]") {
       o.compression = codec;
       o.write_summary = summary;
       o.chunk_bytes = 1500;
-      const fs::path file = dir.path / "select.mcap";
+      const fs::path file = dir / "select.mcap";
       const auto written = write_sample(file, o);
       McapReader r(file);
       CHECK(read_all(r, {topic_index(r, "/b")}) == expected(written, "/b"));
@@ -263,7 +256,7 @@ TEST_CASE("mcap message offsets: the record for uncompressed data, the chunk oth
       o.compression = codec;
       o.chunked = chunked;
       o.chunk_bytes = 1000;
-      const fs::path file = dir.path / "offsets.mcap";
+      const fs::path file = dir / "offsets.mcap";
       write_sample(file, o);
       const auto bytes = file_bytes(file);
       McapReader r(file);
@@ -277,7 +270,7 @@ TEST_CASE("mcap message offsets: the record for uncompressed data, the chunk oth
 
 TEST_CASE("mcap files without messages, encodings ULC does not decode", "[mcap]") {
   TempDir dir;
-  const fs::path file = dir.path / "empty.mcap";
+  const fs::path file = dir / "empty.mcap";
   {
     McapWriter w(file);
     w.add_channel("/quiet", w.add_schema("std_msgs/msg/Empty", "ros2msg", ""), "cdr");
@@ -299,7 +292,7 @@ TEST_CASE("mcap files without messages, encodings ULC does not decode", "[mcap]"
 
 TEST_CASE("mcap CRC mismatches are detected", "[mcap]") {
   TempDir dir;
-  const fs::path file = dir.path / "crc.mcap";
+  const fs::path file = dir / "crc.mcap";
   SECTION("a byte of an uncompressed chunk's records") {
     McapWriteOptions o;
     o.chunk_bytes = 1 << 16;
@@ -348,17 +341,17 @@ TEST_CASE("mcap CRC mismatches are detected", "[mcap]") {
 
 TEST_CASE("mcap reader errors for files that are not MCAP", "[mcap]") {
   TempDir dir;
-  const fs::path file = dir.path / "not.mcap";
+  const fs::path file = dir / "not.mcap";
   std::ofstream(file) << "hello, this is not an MCAP file at all";
   CHECK_THROWS_AS(McapReader(file), ulc::io::IoError);
   std::ofstream(file, std::ios::trunc).close();
   CHECK_THROWS_AS(McapReader(file), ulc::io::IoError);
-  CHECK_THROWS_AS(McapReader(dir.path / "missing.mcap"), ulc::io::IoError);
+  CHECK_THROWS_AS(McapReader(dir / "missing.mcap"), ulc::io::IoError);
 }
 
 TEST_CASE("mcap summary without usable ChunkIndex records: chunks found by the walk", "[mcap]") {
   TempDir dir;
-  const fs::path file = dir.path / "unindexed.mcap";
+  const fs::path file = dir / "unindexed.mcap";
   for (Codec codec : {Codec::none, Codec::zstd}) {
     McapWriteOptions o;
     o.compression = codec;

@@ -14,6 +14,7 @@
 #include <tuple>
 #include <vector>
 
+#include "../support/temp_dir.hpp"
 #include "ulc/bags/ros1_bag.hpp"
 #include "ulc/bags/ros1_bag_writer.hpp"
 
@@ -23,27 +24,29 @@ namespace fs = std::filesystem;
 using Bytes = std::vector<unsigned char>;
 using ulc::bags::Codec;
 
-/// A fresh folder under the system temp dir, removed when the object dies.
-class TempDir {
- public:
-  TempDir() {
-    static std::atomic<int> counter{0};
-    path_ = fs::temp_directory_path() /
-            ("ulc_ros1_bag_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  fs::path operator/(const std::string& name) const { return path_ / name; }
-
- private:
-  fs::path path_;
+/// A fresh folder under the system temp dir (tests/support/temp_dir.hpp).
+struct TempDir : ulc_test::TempDir {
+  TempDir() : ulc_test::TempDir("ulc_ros1_bag_test") {}
 };
+path_ = fs::temp_directory_path() /
+        ("ulc_ros1_bag_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
+fs::remove_all(path_);
+fs::create_directories(path_);
+}
+~TempDir() {
+  std::error_code ec;
+  fs::remove_all(path_, ec);
+}
+TempDir(const TempDir&) = delete;
+TempDir& operator=(const TempDir&) = delete;
+fs::path operator/(const std::string& name) const {
+  return path_ / name;
+}
+
+private:
+fs::path path_;
+}
+;
 
 /// One message as written or read: comparable as a whole.
 struct Message {

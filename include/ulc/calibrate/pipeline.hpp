@@ -21,8 +21,8 @@
 //     ("source") and why. JEEP pairs frames by timestamp from frame i of each on and uses the first
 //     JeepOptions::frames pairs. Frames before i are never touched.
 //   - Stages: any ordered subset of terra, jeep, hots (stages.hpp); the default is all three
-//     (docs/design.md). TERRA needs no prior and ignores `initial`; each later stage starts from the
-//     previous stage's extrinsic, or from `initial` when it is the first, which is then
+//     (docs/design.md). TERRA needs no prior and ignores `initial`; each later stage starts from
+//     the previous stage's extrinsic, or from `initial` when it is the first, which is then
 //     required (status initial_required without it).
 //   - HOTS: multi-LiDAR odometry (options.odometry) over ALL frames of each LiDAR from frame i
 //     on, with the extrinsic HOTS starts from, then hots::refine (options.hots) on those frames
@@ -65,8 +65,8 @@
 #include "jeep/run_odometry.hpp"
 #include "terra/search.hpp"
 #include "ulc/calibrate/frame_range.hpp"
-#include "ulc/calibrate/options.hpp"
 #include "ulc/calibrate/map_terra.hpp"
+#include "ulc/calibrate/options.hpp"
 #include "ulc/calibrate/pair_calibration.hpp"
 #include "ulc/calibrate/stages.hpp"
 #include "ulc/calibrate/terra_hypotheses.hpp"
@@ -328,8 +328,9 @@ inline bool odometry_usable(const jeep::OdometryResult& odo) {
 /// FramesB. ulc::calibrate_pair (ulc/calibrate.hpp) runs this once, on PointCloud<float>.
 template <class FramesA, class FramesB>
 PairCalibration calibrate_pair_in_place(const FramesA& frames_a, const std::vector<double>& times_a,
-                               const FramesB& frames_b, const std::vector<double>& times_b_own,
-                               const CalibrateOptions& options = {}) {
+                                        const FramesB& frames_b,
+                                        const std::vector<double>& times_b_own,
+                                        const CalibrateOptions& options = {}) {
   using calibrate_detail::seconds_since;
   using calibrate_detail::StageOutcome;
   const auto start = std::chrono::steady_clock::now();
