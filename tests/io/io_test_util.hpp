@@ -31,28 +31,6 @@ using Bytes = std::vector<unsigned char>;
 struct TempDir : ulc_test::TempDir {
   TempDir() : ulc_test::TempDir("ulc_io_test") {}
 };
-path_ = fs::temp_directory_path() /
-        ("ulc_io_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
-fs::remove_all(path_);
-fs::create_directories(path_);
-}
-~TempDir() {
-  std::error_code ec;
-  fs::remove_all(path_, ec);
-}
-TempDir(const TempDir&) = delete;
-TempDir& operator=(const TempDir&) = delete;
-const fs::path& path() const {
-  return path_;
-}
-fs::path operator/(const std::string& name) const {
-  return path_ / name;
-}
-
-private:
-fs::path path_;
-}
-;
 
 /// Appends raw values (host = little endian) or text.
 struct ByteBuilder {

@@ -28,25 +28,6 @@ using ulc::bags::Codec;
 struct TempDir : ulc_test::TempDir {
   TempDir() : ulc_test::TempDir("ulc_ros1_bag_test") {}
 };
-path_ = fs::temp_directory_path() /
-        ("ulc_ros1_bag_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
-fs::remove_all(path_);
-fs::create_directories(path_);
-}
-~TempDir() {
-  std::error_code ec;
-  fs::remove_all(path_, ec);
-}
-TempDir(const TempDir&) = delete;
-TempDir& operator=(const TempDir&) = delete;
-fs::path operator/(const std::string& name) const {
-  return path_ / name;
-}
-
-private:
-fs::path path_;
-}
-;
 
 /// One message as written or read: comparable as a whole.
 struct Message {
