@@ -53,11 +53,15 @@ class FolderInput : public LidarInput {
   }
 
   std::string source() const override { return seq_.path().string(); }
-  const io::Sequence& sequence() const { return seq_; }
+
+  std::string name_when_repeated() const override {
+    const fs::path p = seq_.path().lexically_normal();
+    const fs::path parent = (p.filename().empty() ? p.parent_path() : p).parent_path().filename();
+    return parent.empty() ? name_ : parent.string() + "/" + name_;
+  }
 
   void visit(std::size_t first, std::size_t count, const FrameVisitor& fn) const override {
-    const std::size_t end = first + std::min(count, selected_.size());
-    for (std::size_t k = first; k < std::min(end, selected_.size()); ++k) {
+    for (std::size_t k = first, done = 0; k < selected_.size() && done < count; ++k, ++done) {
       auto frame = seq_.load_frame<PointCloud<float>>(selected_[k]);
       if (!fn(std::move(frame.cloud), frame.timestamp)) return;
     }
@@ -124,13 +128,12 @@ class TopicInput : public LidarInput {
                             (options.window.start_s || options.window.duration_s
                                  ? " inside the --start / --duration window"
                                  : ""));
-    frame_id_ = first.message.header.frame_id;
-    name_ = frame_id_.empty() ? topic : frame_id_;
+    const std::string& frame_id = first.message.header.frame_id;
+    name_ = frame_id.empty() ? topic : frame_id;
   }
 
   std::string source() const override { return rec_->path + ":" + topic_.info().name; }
-  const std::string& frame_id() const { return frame_id_; }
-  const std::string& topic() const { return topic_.info().name; }
+  std::string name_when_repeated() const override { return topic_.info().name; }
 
   void visit(std::size_t first, std::size_t count, const FrameVisitor& fn) const override {
     auto frames = topic_.frames(window_);
@@ -163,7 +166,6 @@ class TopicInput : public LidarInput {
   std::shared_ptr<Recording> rec_;
   bags::CloudTopic topic_;
   bags::TimeWindow window_;
-  std::string frame_id_;
 };
 
 std::unique_ptr<LidarInput> open_one(const LidarSpec& spec, const InputOptions& options,
@@ -177,22 +179,15 @@ std::unique_ptr<LidarInput> open_one(const LidarSpec& spec, const InputOptions& 
   return std::make_unique<TopicInput>(rec, topic_of(spec, *rec, command), options);
 }
 
-/// Parent-folder names for files whose stems repeat; topics for frame_ids that repeat.
+/// Default names that repeat take their name_when_repeated().
 void disambiguate(std::vector<std::unique_ptr<LidarInput>>& inputs,
                   const std::vector<LidarSpec>& specs) {
   std::map<std::string, int> seen;
   for (std::size_t i = 0; i < inputs.size(); ++i)
     if (specs[i].name.empty()) ++seen[inputs[i]->name()];
-  for (std::size_t i = 0; i < inputs.size(); ++i) {
-    if (!specs[i].name.empty() || seen[inputs[i]->name()] < 2) continue;
-    if (const auto* topic = dynamic_cast<const TopicInput*>(inputs[i].get())) {
-      inputs[i]->set_name(topic->topic());
-      continue;
-    }
-    const fs::path p = fs::path(specs[i].path).lexically_normal();
-    const fs::path parent = (p.filename().empty() ? p.parent_path() : p).parent_path().filename();
-    if (!parent.empty()) inputs[i]->set_name(parent.string() + "/" + inputs[i]->name());
-  }
+  for (std::size_t i = 0; i < inputs.size(); ++i)
+    if (specs[i].name.empty() && seen[inputs[i]->name()] >= 2)
+      inputs[i]->set_name(inputs[i]->name_when_repeated());
 }
 
 void require_unique_names(const std::vector<std::unique_ptr<LidarInput>>& inputs,

@@ -63,6 +63,9 @@ class LidarInput {
 
   /// "drive.bag:/points" or the folder, for messages.
   virtual std::string source() const = 0;
+  /// The name to take when the default name repeats: the parent folder joined to a file's or
+  /// folder's name, a recording's topic.
+  virtual std::string name_when_repeated() const = 0;
   /// Returns false to stop early.
   using FrameVisitor = std::function<bool(PointCloud<float>&& cloud, double time)>;
   /// Reads frames first .. first + count - 1 of the selection (fewer when it ends first) one at a
