@@ -4,7 +4,7 @@
 //   bench_hots --accuracy    [--scenarios 64-32,...] [--seconds 60] [--runs 10]
 //   bench_hots --time-offset [--scenarios 64-32,64-horizon] [--seconds 60] [--runs 10]
 //                            [--spread-png PREFIX] [--offset-ms 50]
-//   common: [--decimation 1] [--threads 2] [--deskew-from-base] [--jeep-decides]
+//   common: [--decimation 1] [--threads 2] [--jeep-decides]
 //           [--first-run 0] [--json]
 //           [--layers N] [--trajectory PREFIX] [--hots NAME=VALUE ...] [--steering-ramp M]
 //           [--no-traffic]
@@ -23,9 +23,6 @@
 //   --jeep-decides: a failed JEEP ends the run (by default, as in the pipeline, a JEEP that was
 //   rejected or did not settle hands its extrinsic to HOTS, whose cross links judge it:
 //   CalibrateOptions::hots_judges_jeep; the stderr line says "judged").
-//   --deskew-from-base: the whole-sequence step reads b's frames deskewed afresh with the
-//   base's refined trajectory (SequenceExtrinsicOptions::deskew_from_base) instead of b's own
-//   odometry.
 //
 // Each run simulates the drive with seed = run index + 1 (runs --first-run onwards), disturbs the
 // truth by 5 deg about a random axis and 2 m in a random direction (seeded by the run), runs JEEP
@@ -65,7 +62,6 @@
 #include "../tests/jeep/jeep_test_util.hpp"
 #include "hots/hots.hpp"
 #include "jeep/run_odometry.hpp"
-#include "support/bench_args.hpp"
 #include "support/bench_util.hpp"
 #include "support/curve_png.hpp"
 #include "ulc/calibrate.hpp"
@@ -87,14 +83,13 @@ struct Config {
   std::size_t first_run = 0;  ///< --first-run: runs first_run .. first_run + runs - 1
   unsigned decimation = 1;
   int threads = 2;
-  std::string spread_png;         ///< prefix of the spread curve pictures; empty: none
-  bool deskew_from_base = false;  ///< --deskew-from-base
-  bool hots_judges_jeep = true;   ///< off with --jeep-decides
-  double pre_shift_s = 0.0;       ///< --pre-shift-ms
-  bool no_traffic = false;        ///< --no-traffic: the scenario without its oncoming cars
-  double steering_ramp_m = 0.0;   ///< --steering-ramp M: MotionSpec::steering_ramp_m
-  int layers = 0;                 ///< --layers: HOTS hierarchy layers; 0: the default
-  std::string trajectory;         ///< --trajectory PREFIX: per-frame poses of each run, as CSV
+  std::string spread_png;        ///< prefix of the spread curve pictures; empty: none
+  bool hots_judges_jeep = true;  ///< off with --jeep-decides
+  double pre_shift_s = 0.0;      ///< --pre-shift-ms
+  bool no_traffic = false;       ///< --no-traffic: the scenario without its oncoming cars
+  double steering_ramp_m = 0.0;  ///< --steering-ramp M: MotionSpec::steering_ramp_m
+  int layers = 0;                ///< --layers: HOTS hierarchy layers; 0: the default
+  std::string trajectory;        ///< --trajectory PREFIX: per-frame poses of each run, as CSV
   std::vector<std::string> hots_settings;       ///< --hots NAME=VALUE, applied in order
   std::vector<double> offsets_s = {0.05, 0.0};  ///< --time-offset's offsets (--offset-ms X: X)
   ulc_bench::Options bench;
@@ -294,7 +289,6 @@ Run one_run(const std::string& scenario, double offset_s, std::size_t run, const
     ulc::CalibrateOptions o;
     o.stages = {ulc::Stage::jeep};
     o.initial = initial;
-    o.hots.sequence.deskew_from_base = c.deskew_from_base;
     if (c.layers > 0) o.hots.hierarchy.layers = c.layers;
     for (const auto& setting : c.hots_settings) apply_hots_setting(o.hots, setting);
     const auto j = ulc::calibrate_pair(a.frames, a.timestamps, b.frames, times_b, o);
@@ -512,29 +506,54 @@ void bench(Config c) {
 
 int main(int argc, char** argv) {
   Config c;
-  ulc_bench::Args args;
-  args.flag("--accuracy", [&] { c.mode = "accuracy"; })
-      .flag("--time-offset", [&] { c.mode = "time-offset"; })
-      .value("--scenarios", ulc_bench::list(c.scenarios))
-      .value("--seconds", ulc_bench::number(c.seconds))
-      .value("--runs", ulc_bench::at_least(c.runs, std::size_t{1}))
-      .value("--first-run", ulc_bench::at_least(c.first_run, std::size_t{0}))
-      .value("--decimation", ulc_bench::at_least(c.decimation, 1u))
-      .value("--threads", ulc_bench::at_least(c.threads, 1))
-      .value("--spread-png", ulc_bench::text(c.spread_png))
-      .value("--offset-ms", [&](const char* s) { c.offsets_s = {std::atof(s) * 1e-3}; })
-      .value("--pre-shift-ms", ulc_bench::number(c.pre_shift_s, 1e-3))
-      .value("--layers", ulc_bench::at_least(c.layers, 1))
-      .value("--trajectory", ulc_bench::text(c.trajectory))
-      .value("--hots", ulc_bench::append(c.hots_settings))
-      .value("--steering-ramp", ulc_bench::number(c.steering_ramp_m))
-      .flag("--no-traffic", [&] { c.no_traffic = true; })
-      .flag("--deskew-from-base", [&] { c.deskew_from_base = true; })
-      .flag("--jeep-decides", [&] { c.hots_judges_jeep = false; });
-  c.bench = args.parse(argc, argv,
-                       "HOTS after JEEP on simulated drives (modes: --accuracy --time-offset; "
-                       "options --scenarios --seconds --runs --first-run --decimation --threads "
-                       "--spread-png)");
+  CLI::App app(
+      "HOTS after JEEP on simulated drives, against the ground truth (modes: --accuracy, "
+      "--time-offset; see the top of bench/bench_hots.cpp)",
+      "bench_hots");
+  ulc_bench::add_options(app, c.bench);
+  app.add_flag_callback(
+      "--accuracy", [&] { c.mode = "accuracy"; }, "accuracy mode (default)");
+  app.add_flag_callback(
+      "--time-offset", [&] { c.mode = "time-offset"; },
+      "time-offset mode: target clock 50 ms behind, and no offset");
+  app.add_option("--scenarios", c.scenarios, "scenarios (default: the mode's)")
+      ->delimiter(',')
+      ->type_name("A,B,...");
+  app.add_option("--seconds", c.seconds, "simulated drive (default 60)")->type_name("S");
+  app.add_option("--runs", c.runs, "runs per scenario (default 10)")
+      ->type_name("N")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--first-run", c.first_run, "first run's index (default 0)")->type_name("K");
+  app.add_option("--decimation", c.decimation, "keep every Nth point (default 1)")
+      ->type_name("N")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--threads", c.threads, "worker threads (default 2)")
+      ->type_name("N")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--spread-png", c.spread_png, "draw run 0's spread curves to PREFIX_...png")
+      ->type_name("PREFIX");
+  app.add_option_function<double>(
+         "--offset-ms", [&](double ms) { c.offsets_s = {ms * 1e-3}; },
+         "--time-offset: only this offset")
+      ->type_name("X");
+  app.add_option_function<double>(
+         "--pre-shift-ms", [&](double ms) { c.pre_shift_s = ms * 1e-3; },
+         "shift the target's timestamps before HOTS")
+      ->type_name("X");
+  app.add_option("--layers", c.layers, "HOTS's hierarchy layers (default 3)")
+      ->type_name("N")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--trajectory", c.trajectory, "per run, PREFIX_<scenario>_run<k>.csv")
+      ->type_name("PREFIX");
+  app.add_option("--hots", c.hots_settings, "one of HOTS's numeric options (repeatable)")
+      ->type_name("NAME=VALUE")
+      ->allow_extra_args(false);
+  app.add_option("--steering-ramp", c.steering_ramp_m, "route averaged over M metres")
+      ->type_name("M");
+  app.add_flag("--no-traffic", c.no_traffic, "no oncoming cars");
+  app.add_flag_callback(
+      "--jeep-decides", [&] { c.hots_judges_jeep = false; }, "a failed JEEP ends the run");
+  CLI11_PARSE(app, argc, argv);
   bench(c);
   return 0;
 }

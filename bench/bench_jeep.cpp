@@ -7,10 +7,8 @@
 //   bench_jeep --robustness [--scenarios 64-32,64-horizon] [--starts 3] [--png DIR]
 //   bench_jeep --frames-sweep [--scenarios 64-32,64-horizon,64-tele] [--starts 5] [--png DIR]
 //   bench_jeep --odometry   [--seconds 20] [--repeats 1]
-//   common: [--seconds 20] [--seed 1] [--threads 2] [--cache DIR] [--one-way]
-//           [--second-look] [--json]
+//   common: [--seconds 20] [--seed 1] [--threads 2] [--cache DIR] [--one-way] [--json]
 //   --one-way: JEEP without its two-way step (jeep/two_way.hpp), the earlier behaviour.
-//   --second-look: JEEP with the second look at sparse pairs (jeep/second_look.hpp; opt-in).
 //
 // (a) accuracy, the paper's protocol: the ground truth disturbed by 5 deg about a random axis
 //     and 2 m in a random direction (seeded per start), at --starts windows spread evenly along
@@ -45,7 +43,6 @@
 #include "jeep/jeep.hpp"
 #include "jeep/run_odometry.hpp"
 #include "jeep/scan_scan.hpp"
-#include "support/bench_args.hpp"
 #include "support/bench_util.hpp"
 #include "support/heatmap_png.hpp"
 #include "ulc/core/pose_error.hpp"
@@ -68,9 +65,8 @@ struct Config {
   std::uint64_t seed = 1;
   int threads = 2;
   std::string cache = "/tmp/ulc_jeep_cache";
-  std::string png_dir;       ///< --png DIR: robustness and frames-sweep heat maps as PNG
-  bool one_way = false;      ///< --one-way: JEEP without the two-way step
-  bool second_look = false;  ///< --second-look: a second look at refusals (opt-in)
+  std::string png_dir;   ///< --png DIR: robustness and frames-sweep heat maps as PNG
+  bool one_way = false;  ///< --one-way: JEEP without the two-way step
   ulc_bench::Options bench;
 };
 
@@ -79,7 +75,6 @@ jeep::JeepOptions jeep_options(const Config& c, std::size_t frames) {
   jeep::JeepOptions o;
   o.frames = frames;
   o.two_way = !c.one_way;
-  o.second_look.enabled = c.second_look;
   return o;
 }
 
@@ -172,7 +167,6 @@ struct Outcome {
   double directional_overlap = 0.0;
   double off_ground_overlap = 0.0;
   double condition = 0.0;
-  bool by_second_look = false;  ///< accepted by the second look (jeep/second_look.hpp)
   int rounds = 0;
 };
 
@@ -182,13 +176,11 @@ bool success(const Outcome& o) {
 
 struct Summary {
   std::size_t runs = 0, successes = 0, accepted = 0, false_accepts = 0, within = 0;
-  std::size_t by_second_look = 0;
   std::vector<double> rot, trans, time, rounds;
   void add(const Outcome& o) {
     ++runs;
     successes += success(o) ? 1 : 0;
     accepted += o.ok ? 1 : 0;
-    by_second_look += o.ok && o.by_second_look ? 1 : 0;
     false_accepts += o.ok && !ulc::is_calibration_success(o.error) ? 1 : 0;
     within += ulc::is_calibration_success(o.error) ? 1 : 0;
     rot.push_back(o.error.rotation_deg);
@@ -213,7 +205,6 @@ Outcome run_jeep(const Window& w, const Isometry3d& initial, const Isometry3d& t
   out.directional_overlap = r.acceptance.directional_overlap;
   out.off_ground_overlap = r.acceptance.off_ground_overlap;
   out.condition = r.acceptance.condition;
-  out.by_second_look = r.second_look.passed;
   out.rounds = r.rounds;
   return out;
 }
@@ -256,9 +247,8 @@ void accuracy(Config c) {
     c.scenarios = {"64-32", "32-16", "horizon-tele", "64-horizon", "32-avia", "64-tele"};
   if (!c.starts) c.starts = 50;
   ulc_bench::Table table({"scenario", "method", "runs", "success_pct", "accepted_pct",
-                          "false_accepts", "by_second_look", "median_e_rot_deg",
-                          "median_e_trans_cm", "p90_e_rot_deg", "p90_e_trans_cm", "median_rounds",
-                          "median_time_s"});
+                          "false_accepts", "median_e_rot_deg", "median_e_trans_cm", "p90_e_rot_deg",
+                          "p90_e_trans_cm", "median_rounds", "median_time_s"});
   const jeep::JeepOptions o = jeep_options(c, c.frames);
   for (const auto& scenario : c.scenarios) {
     const Drive d = load_drive(scenario, c);
@@ -284,7 +274,6 @@ void accuracy(Config c) {
                      Cell::integer(static_cast<long long>(sum->runs)),
                      Cell::num(sum->pct(sum->successes), 1), Cell::num(sum->pct(sum->accepted), 1),
                      Cell::integer(static_cast<long long>(sum->false_accepts)),
-                     Cell::integer(static_cast<long long>(sum->by_second_look)),
                      Cell::num(jeep_test::median(sum->rot), 4),
                      Cell::num(100 * jeep_test::median(sum->trans), 2), Cell::num(p90(sum->rot), 4),
                      Cell::num(100 * p90(sum->trans), 2),
@@ -311,8 +300,8 @@ void separation(Config c) {
   if (c.scenarios.empty())
     c.scenarios = {"64-32", "32-16", "horizon-tele", "64-horizon", "32-avia", "64-tele"};
   if (!c.starts) c.starts = 10;
-  ulc_bench::Table table({"scenario", "data", "runs", "settled", "accepted_pct", "by_second_look",
-                          "overlap_median", "dir_overlap_min", "dir_overlap_max", "off_ground_min",
+  ulc_bench::Table table({"scenario", "data", "runs", "settled", "accepted_pct", "overlap_median",
+                          "dir_overlap_min", "dir_overlap_max", "off_ground_min",
                           "off_ground_median", "off_ground_max", "condition_min"});
   const jeep::JeepOptions o = jeep_options(c, c.frames);
   for (const auto& scenario : c.scenarios) {
@@ -320,7 +309,7 @@ void separation(Config c) {
     const std::size_t half = d.pairs.size() / 2;
     for (int unrelated = 0; unrelated < 2; ++unrelated) {
       std::vector<double> overlap, directional, off_ground, condition;
-      std::size_t accepted = 0, runs = 0, by_second_look = 0;
+      std::size_t accepted = 0, runs = 0;
       for (std::size_t s : start_pairs(d, c.starts, c.frames)) {
         // Unrelated: b's frames from half a drive away (another street), a's timestamps.
         std::size_t b_first = SIZE_MAX;
@@ -329,7 +318,6 @@ void separation(Config c) {
         const Outcome r = run_jeep(window(d, s, c.frames, b_first), initial, d.truth, o, c.threads);
         ++runs;
         accepted += r.ok ? 1 : 0;
-        by_second_look += r.ok && r.by_second_look ? 1 : 0;
         // The rule judges settled runs only; a true run that settled away from the truth is
         // not evidence of what the truth looks like.
         const bool settled = r.status == "ok" || r.status == "rejected";
@@ -349,7 +337,6 @@ void separation(Config c) {
                      Cell::integer(static_cast<long long>(runs)),
                      Cell::integer(static_cast<long long>(overlap.size())),
                      Cell::num(runs ? 100.0 * accepted / runs : 0.0, 1),
-                     Cell::integer(static_cast<long long>(by_second_look)),
                      Cell::num(jeep_test::median(overlap), 3), Cell::num(mn(directional), 3),
                      Cell::num(mx(directional), 3), Cell::num(mn(off_ground), 3),
                      Cell::num(jeep_test::median(off_ground), 3), Cell::num(mx(off_ground), 3),
@@ -367,12 +354,11 @@ void separation(Config c) {
        {"overlap", "agreeing / near points of the smaller map (acceptance.hpp)"},
        {"dir_overlap", "agreeing share of the near points' information in the weakest direction"},
        {"off_ground", "the same over the directions the dominant plane (the ground) leaves free"},
-       {"rule", "accept iff off_ground >= " +
-                    std::to_string(jeep::AcceptanceOptions{}.min_off_ground_overlap) +
-                    ", dir_overlap >= " +
-                    std::to_string(jeep::AcceptanceOptions{}.min_directional_overlap) +
-                    " and condition >= " + std::to_string(jeep::AcceptanceOptions{}.min_condition) +
-                    (c.second_look ? ", or by the second look (jeep/second_look.hpp)" : "")}});
+       {"rule",
+        "accept iff off_ground >= " +
+            std::to_string(jeep::AcceptanceOptions{}.min_off_ground_overlap) + ", dir_overlap >= " +
+            std::to_string(jeep::AcceptanceOptions{}.min_directional_overlap) +
+            " and condition >= " + std::to_string(jeep::AcceptanceOptions{}.min_condition)}});
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -622,25 +608,38 @@ void registration(Config c) {
 
 int main(int argc, char** argv) {
   Config c;
-  const bool repeats_given = std::any_of(
-      argv + 1, argv + argc, [](const char* a) { return std::string(a) == "--repeats"; });
-  ulc_bench::Args args;
+  CLI::App app(
+      "JEEP, scan-scan, odometry and ICP on simulated drives (modes: --accuracy "
+      "--separation --robustness --frames-sweep --odometry --registration; see the top "
+      "of bench/bench_jeep.cpp)",
+      "bench_jeep");
+  ulc_bench::add_options(app, c.bench);
   for (const char* mode :
        {"accuracy", "separation", "robustness", "odometry", "frames-sweep", "registration"})
-    args.flag(std::string("--") + mode, [&c, mode] { c.mode = mode; });
-  args.value("--scenarios", ulc_bench::list(c.scenarios))
-      .value("--starts", ulc_bench::at_least(c.starts, std::size_t{1}))
-      .value("--frames", ulc_bench::at_least(c.frames, std::size_t{1}))
-      .value("--seconds", ulc_bench::number(c.seconds))
-      .value("--seed", ulc_bench::at_least(c.seed, std::uint64_t{0}))
-      .value("--threads", ulc_bench::at_least(c.threads, 1))
-      .value("--cache", ulc_bench::text(c.cache))
-      .value("--png", ulc_bench::text(c.png_dir))
-      .flag("--one-way", [&] { c.one_way = true; })
-      .flag("--second-look", [&] { c.second_look = true; });
-  c.bench = args.parse(argc, argv,
-                       "JEEP, scan-scan, odometry and ICP on simulated drives (modes: --accuracy "
-                       "--separation --robustness --frames-sweep --odometry --registration)");
+    app.add_flag_callback(
+        std::string("--") + mode, [&c, mode] { c.mode = mode; },
+        std::string("run the ") + mode + " bench (default: registration)");
+  app.add_option("--scenarios", c.scenarios, "scenarios (default: the mode's)")
+      ->delimiter(',')
+      ->type_name("A,B,...");
+  app.add_option("--starts", c.starts, "starts per scenario (default: the mode's)")
+      ->type_name("N")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--frames", c.frames, "frame pairs K (default 5)")
+      ->type_name("K")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--seconds", c.seconds, "simulated drive (default 20)")->type_name("S");
+  app.add_option("--seed", c.seed, "disturbance seed (default 1)")->type_name("N");
+  app.add_option("--threads", c.threads, "worker threads (default 2)")
+      ->type_name("N")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--cache", c.cache, "folder of the cached drives (default /tmp/ulc_jeep_cache)")
+      ->type_name("DIR");
+  app.add_option("--png", c.png_dir, "robustness and frames-sweep heat maps as PNG")
+      ->type_name("DIR");
+  app.add_flag("--one-way", c.one_way, "JEEP without its two-way step");
+  CLI11_PARSE(app, argc, argv);
+  const bool repeats_given = app.count("--repeats") > 0;
   if (c.mode == "accuracy") {
     accuracy(c);
   } else if (c.mode == "separation") {

@@ -4,12 +4,10 @@
 //
 //   bench_rig [--scenarios ring-5x16,pitched-90,side-bpearl] [--seconds 10]
 //             [--stages terra,jeep,hots] [--decimation 1] [--seed 1] [--threads 2]
-//             [--no-route] [--no-cycles] [--synced-clocks] [--second-look] [--json]
+//             [--no-route] [--no-cycles] [--synced-clocks] [--json]
 // --synced-clocks: the pairs are told their clocks agree (the simulated rigs' do), so HOTS
 // neither estimates nor checks an offset; without it, a drive too short to pin the offset down
 // fails with time_offset_untrusted.
-// --second-look: JEEP's opt-in second look at refusals for the directional overlap alone
-// (include/jeep/second_look.hpp), for the pairs and the cycle checks.
 //
 // Per target: e_rot (deg) and e_trans (cm) against the simulator's mounts, the calibration's
 // status, the route, the clock offset error when HOTS ran, the cross links of the kept result
@@ -27,7 +25,6 @@
 #include <string>
 #include <vector>
 
-#include "support/bench_args.hpp"
 #include "support/bench_util.hpp"
 #include "ulc/calibrate/rig.hpp"
 #include "ulc/core/pose_error.hpp"
@@ -47,7 +44,6 @@ struct Config {
   bool route = true;
   bool cycles = true;
   bool synced_clocks = false;  ///< --synced-clocks: no clock offset estimated (the rigs share one)
-  bool second_look = false;    ///< --second-look: JEEP's second look (opt-in)
   ulc_bench::Options bench;
 };
 
@@ -94,7 +90,6 @@ void bench(const Config& c) {
     ulc::RigOptions o;
     o.pair.stages = stages.stages;
     if (c.synced_clocks) o.pair.time_offset_s = 0.0;
-    o.pair.jeep.second_look.enabled = c.second_look;
     o.route = c.route;
     o.cycles = c.cycles;
     if (!c.bench.json)
@@ -180,21 +175,30 @@ void bench(const Config& c) {
 
 int main(int argc, char** argv) {
   Config c;
-  ulc_bench::Args args;
-  args.value("--scenarios", ulc_bench::list(c.scenarios))
-      .value("--seconds", ulc_bench::number(c.seconds))
-      .value("--stages", ulc_bench::text(c.stages))
-      .value("--decimation", ulc_bench::at_least(c.decimation, 1u))
-      .value("--seed", ulc_bench::at_least(c.seed, std::uint64_t{0}))
-      .value("--threads", ulc_bench::at_least(c.threads, 1))
-      .flag("--no-route", [&] { c.route = false; })
-      .flag("--no-cycles", [&] { c.cycles = false; })
-      .flag("--synced-clocks", [&] { c.synced_clocks = true; })
-      .flag("--second-look", [&] { c.second_look = true; });
-  c.bench = args.parse(argc, argv,
-                       "whole rigs with no initial guess (options --scenarios --seconds --stages "
-                       "--decimation --seed --threads --no-route --no-cycles --synced-clocks "
-                       "--second-look)");
+  CLI::App app(
+      "whole simulated rigs calibrated with no initial guess (see the top of "
+      "bench/bench_rig.cpp)",
+      "bench_rig");
+  ulc_bench::add_options(app, c.bench);
+  app.add_option("--scenarios", c.scenarios, "scenarios (default ring-5x16,pitched-90,side-bpearl)")
+      ->delimiter(',')
+      ->type_name("A,B,...");
+  app.add_option("--seconds", c.seconds, "simulated drive (default 10)")->type_name("S");
+  app.add_option("--stages", c.stages, "the pairs' stages (default terra,jeep,hots)")
+      ->type_name("LIST");
+  app.add_option("--decimation", c.decimation, "keep every Nth point (default 1)")
+      ->type_name("N")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--seed", c.seed, "simulation seed (default 1)")->type_name("N");
+  app.add_option("--threads", c.threads, "worker threads (default 2)")
+      ->type_name("N")
+      ->check(CLI::PositiveNumber);
+  app.add_flag_callback(
+      "--no-route", [&] { c.route = false; }, "no routes through other targets");
+  app.add_flag_callback(
+      "--no-cycles", [&] { c.cycles = false; }, "no cycle checks");
+  app.add_flag("--synced-clocks", c.synced_clocks, "the pairs' clocks agree: no offset estimated");
+  CLI11_PARSE(app, argc, argv);
   bench(c);
   return 0;
 }

@@ -27,7 +27,6 @@
 #include "../tests/jeep/jeep_test_util.hpp"
 #include "hots/hots.hpp"
 #include "jeep/run_odometry.hpp"
-#include "support/bench_args.hpp"
 #include "support/bench_util.hpp"
 #include "ulc/calibrate.hpp"
 #include "ulc/calibrate/pipeline.hpp"
@@ -184,15 +183,19 @@ void bench(const Config& c) {
 
 int main(int argc, char** argv) {
   Config c;
-  ulc_bench::Args args;
-  args.value("--scenarios", ulc_bench::list(c.scenarios))
-      .value("--seconds", ulc_bench::number(c.seconds))
-      .value("--runs", ulc_bench::at_least(c.runs, std::size_t{1}))
-      .value("--first-run", ulc_bench::at_least(c.first_run, std::size_t{0}))
-      .value("--threads", ulc_bench::at_least(c.threads, 1));
-  c.bench = args.parse(argc, argv,
-                       "JEEP and HOTS from right and wrong starts: does the cross-link rule tell "
-                       "them apart (options --scenarios --seconds --runs --first-run --threads)");
+  CLI::App app(
+      "JEEP and HOTS from right and wrong starts: does the cross-link rule tell them "
+      "apart",
+      "bench_trust");
+  ulc_bench::add_options(app, c.bench);
+  app.add_option("--scenarios", c.scenarios, "scenarios")->delimiter(',')->type_name("A,B,...");
+  app.add_option("--seconds", c.seconds, "simulated drive")->type_name("S");
+  app.add_option("--runs", c.runs, "runs per scenario")->type_name("N")->check(CLI::PositiveNumber);
+  app.add_option("--first-run", c.first_run, "first run's index (default 0)")->type_name("K");
+  app.add_option("--threads", c.threads, "worker threads (default 2)")
+      ->type_name("N")
+      ->check(CLI::PositiveNumber);
+  CLI11_PARSE(app, argc, argv);
   bench(c);
   return 0;
 }
