@@ -10,19 +10,19 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
 #include <string>
 #include <thread>
 #include <utility>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 namespace ulc_bench {
 
@@ -119,10 +119,12 @@ struct Cell {
   }
 };
 
-/// A cell as JSON: its number, else its text.
+/// A cell as JSON: its number (a whole one without ".0"), else its text.
 inline nlohmann::ordered_json json_value(const Cell& c) {
-  if (c.number) return *c.number;
-  return c.text;
+  if (!c.number) return c.text;
+  const double x = *c.number;
+  if (x == std::floor(x) && std::fabs(x) < 1e15) return static_cast<long long>(x);
+  return x;
 }
 
 class Table {

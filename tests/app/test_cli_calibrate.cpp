@@ -108,7 +108,7 @@ TEST_CASE("ulc calibrate --stages terra writes the result file of docs/design.md
   for (const char* key :
        {"base", "target", "success", "status", "reason", "T_base_target", "translation_m",
         "rotation_quat_wxyz", "rpy_deg", "time_offset_s", "covariance_6x6", "stages", "timing_s"})
-    CHECK(entry.find(key) != nullptr);
+    CHECK(entry.contains(key));
   CHECK(entry.at("translation_m").size() == 3);
   CHECK(entry.at("rotation_quat_wxyz").size() == 4);
   CHECK(entry.at("rpy_deg").size() == 3);
@@ -136,7 +136,7 @@ TEST_CASE("ulc calibrate terra,jeep passes ulc evaluate", "[app][calibrate]") {
   // The start search ran (jeep/start_search.hpp): at least the guess's own basin, a start index.
   CHECK(r[0].stages.at("jeep").at("start_basins").get<double>() >= 1);
   CHECK(r[0].stages.at("jeep").at("start_chosen").get<double>() < 13);
-  // The second look is opt-in (jeep/second_look.hpp): without --second-look it never runs.
+  // The second look is opt-in (jeep/second_look.hpp) and the command does not ask for it.
   CHECK(r[0].stages.at("jeep").at("second_look").is_null());
   CHECK(evaluate_success(d, out));
 }
