@@ -7,10 +7,8 @@
 //   bench_jeep --robustness [--scenarios 64-32,64-horizon] [--starts 3] [--png DIR]
 //   bench_jeep --frames-sweep [--scenarios 64-32,64-horizon,64-tele] [--starts 5] [--png DIR]
 //   bench_jeep --odometry   [--seconds 20] [--repeats 1]
-//   common: [--seconds 20] [--seed 1] [--threads 2] [--cache DIR] [--one-way]
-//           [--second-look] [--json]
+//   common: [--seconds 20] [--seed 1] [--threads 2] [--cache DIR] [--one-way] [--json]
 //   --one-way: JEEP without its two-way step (jeep/two_way.hpp), the earlier behaviour.
-//   --second-look: JEEP with the second look at sparse pairs (jeep/second_look.hpp; opt-in).
 //
 // (a) accuracy, the paper's protocol: the ground truth disturbed by 5 deg about a random axis
 //     and 2 m in a random direction (seeded per start), at --starts windows spread evenly along
@@ -43,8 +41,8 @@
 
 #include "../tests/jeep/jeep_test_util.hpp"
 #include "jeep/jeep.hpp"
-#include "jeep/run_odometry.hpp"
 #include "jeep/scan_scan.hpp"
+#include "odometry/run_odometry.hpp"
 #include "support/bench_args.hpp"
 #include "support/bench_util.hpp"
 #include "support/heatmap_png.hpp"
@@ -68,9 +66,8 @@ struct Config {
   std::uint64_t seed = 1;
   int threads = 2;
   std::string cache = "/tmp/ulc_jeep_cache";
-  std::string png_dir;       ///< --png DIR: robustness and frames-sweep heat maps as PNG
-  bool one_way = false;      ///< --one-way: JEEP without the two-way step
-  bool second_look = false;  ///< --second-look: a second look at refusals (opt-in)
+  std::string png_dir;   ///< --png DIR: robustness and frames-sweep heat maps as PNG
+  bool one_way = false;  ///< --one-way: JEEP without the two-way step
   ulc_bench::Options bench;
 };
 
@@ -79,7 +76,6 @@ jeep::JeepOptions jeep_options(const Config& c, std::size_t frames) {
   jeep::JeepOptions o;
   o.frames = frames;
   o.two_way = !c.one_way;
-  o.second_look.enabled = c.second_look;
   return o;
 }
 
@@ -103,7 +99,7 @@ struct FrameWindow {
 
 struct Drive {
   ulc::sim::Dataset data;
-  std::vector<jeep::FramePair> pairs;  ///< every pair of the drive
+  std::vector<odometry::FramePair> pairs;  ///< every pair of the drive
   Isometry3d truth = Isometry3d::Identity();
   const ulc::sim::LidarRecording& a() const { return data.lidars[0]; }
   const ulc::sim::LidarRecording& b() const { return data.lidars[1]; }
@@ -119,8 +115,8 @@ Drive load_drive(const std::string& scenario, const Config& c) {
   Drive d;
   d.data = jeep_test::cached(spec, c.cache);
   d.truth = d.data.pairs.at(0).T_base_target;
-  const double period = jeep::frame_period(d.a().timestamps);
-  d.pairs = jeep::pair_frames(d.a().timestamps, d.b().timestamps, 0.0, 0.5 * period);
+  const double period = odometry::frame_period(d.a().timestamps);
+  d.pairs = odometry::pair_frames(d.a().timestamps, d.b().timestamps, 0.0, 0.5 * period);
   return d;
 }
 
@@ -172,7 +168,6 @@ struct Outcome {
   double directional_overlap = 0.0;
   double off_ground_overlap = 0.0;
   double condition = 0.0;
-  bool by_second_look = false;  ///< accepted by the second look (jeep/second_look.hpp)
   int rounds = 0;
 };
 
@@ -182,13 +177,11 @@ bool success(const Outcome& o) {
 
 struct Summary {
   std::size_t runs = 0, successes = 0, accepted = 0, false_accepts = 0, within = 0;
-  std::size_t by_second_look = 0;
   std::vector<double> rot, trans, time, rounds;
   void add(const Outcome& o) {
     ++runs;
     successes += success(o) ? 1 : 0;
     accepted += o.ok ? 1 : 0;
-    by_second_look += o.ok && o.by_second_look ? 1 : 0;
     false_accepts += o.ok && !ulc::is_calibration_success(o.error) ? 1 : 0;
     within += ulc::is_calibration_success(o.error) ? 1 : 0;
     rot.push_back(o.error.rotation_deg);
@@ -213,7 +206,6 @@ Outcome run_jeep(const Window& w, const Isometry3d& initial, const Isometry3d& t
   out.directional_overlap = r.acceptance.directional_overlap;
   out.off_ground_overlap = r.acceptance.off_ground_overlap;
   out.condition = r.acceptance.condition;
-  out.by_second_look = r.second_look.passed;
   out.rounds = r.rounds;
   return out;
 }
@@ -256,9 +248,8 @@ void accuracy(Config c) {
     c.scenarios = {"64-32", "32-16", "horizon-tele", "64-horizon", "32-avia", "64-tele"};
   if (!c.starts) c.starts = 50;
   ulc_bench::Table table({"scenario", "method", "runs", "success_pct", "accepted_pct",
-                          "false_accepts", "by_second_look", "median_e_rot_deg",
-                          "median_e_trans_cm", "p90_e_rot_deg", "p90_e_trans_cm", "median_rounds",
-                          "median_time_s"});
+                          "false_accepts", "median_e_rot_deg", "median_e_trans_cm", "p90_e_rot_deg",
+                          "p90_e_trans_cm", "median_rounds", "median_time_s"});
   const jeep::JeepOptions o = jeep_options(c, c.frames);
   for (const auto& scenario : c.scenarios) {
     const Drive d = load_drive(scenario, c);
@@ -284,7 +275,6 @@ void accuracy(Config c) {
                      Cell::integer(static_cast<long long>(sum->runs)),
                      Cell::num(sum->pct(sum->successes), 1), Cell::num(sum->pct(sum->accepted), 1),
                      Cell::integer(static_cast<long long>(sum->false_accepts)),
-                     Cell::integer(static_cast<long long>(sum->by_second_look)),
                      Cell::num(jeep_test::median(sum->rot), 4),
                      Cell::num(100 * jeep_test::median(sum->trans), 2), Cell::num(p90(sum->rot), 4),
                      Cell::num(100 * p90(sum->trans), 2),
@@ -311,8 +301,8 @@ void separation(Config c) {
   if (c.scenarios.empty())
     c.scenarios = {"64-32", "32-16", "horizon-tele", "64-horizon", "32-avia", "64-tele"};
   if (!c.starts) c.starts = 10;
-  ulc_bench::Table table({"scenario", "data", "runs", "settled", "accepted_pct", "by_second_look",
-                          "overlap_median", "dir_overlap_min", "dir_overlap_max", "off_ground_min",
+  ulc_bench::Table table({"scenario", "data", "runs", "settled", "accepted_pct", "overlap_median",
+                          "dir_overlap_min", "dir_overlap_max", "off_ground_min",
                           "off_ground_median", "off_ground_max", "condition_min"});
   const jeep::JeepOptions o = jeep_options(c, c.frames);
   for (const auto& scenario : c.scenarios) {
@@ -320,7 +310,7 @@ void separation(Config c) {
     const std::size_t half = d.pairs.size() / 2;
     for (int unrelated = 0; unrelated < 2; ++unrelated) {
       std::vector<double> overlap, directional, off_ground, condition;
-      std::size_t accepted = 0, runs = 0, by_second_look = 0;
+      std::size_t accepted = 0, runs = 0;
       for (std::size_t s : start_pairs(d, c.starts, c.frames)) {
         // Unrelated: b's frames from half a drive away (another street), a's timestamps.
         std::size_t b_first = SIZE_MAX;
@@ -329,7 +319,6 @@ void separation(Config c) {
         const Outcome r = run_jeep(window(d, s, c.frames, b_first), initial, d.truth, o, c.threads);
         ++runs;
         accepted += r.ok ? 1 : 0;
-        by_second_look += r.ok && r.by_second_look ? 1 : 0;
         // The rule judges settled runs only; a true run that settled away from the truth is
         // not evidence of what the truth looks like.
         const bool settled = r.status == "ok" || r.status == "rejected";
@@ -349,7 +338,6 @@ void separation(Config c) {
                      Cell::integer(static_cast<long long>(runs)),
                      Cell::integer(static_cast<long long>(overlap.size())),
                      Cell::num(runs ? 100.0 * accepted / runs : 0.0, 1),
-                     Cell::integer(static_cast<long long>(by_second_look)),
                      Cell::num(jeep_test::median(overlap), 3), Cell::num(mn(directional), 3),
                      Cell::num(mx(directional), 3), Cell::num(mn(off_ground), 3),
                      Cell::num(jeep_test::median(off_ground), 3), Cell::num(mx(off_ground), 3),
@@ -367,12 +355,11 @@ void separation(Config c) {
        {"overlap", "agreeing / near points of the smaller map (acceptance.hpp)"},
        {"dir_overlap", "agreeing share of the near points' information in the weakest direction"},
        {"off_ground", "the same over the directions the dominant plane (the ground) leaves free"},
-       {"rule", "accept iff off_ground >= " +
-                    std::to_string(jeep::AcceptanceOptions{}.min_off_ground_overlap) +
-                    ", dir_overlap >= " +
-                    std::to_string(jeep::AcceptanceOptions{}.min_directional_overlap) +
-                    " and condition >= " + std::to_string(jeep::AcceptanceOptions{}.min_condition) +
-                    (c.second_look ? ", or by the second look (jeep/second_look.hpp)" : "")}});
+       {"rule",
+        "accept iff off_ground >= " +
+            std::to_string(jeep::AcceptanceOptions{}.min_off_ground_overlap) + ", dir_overlap >= " +
+            std::to_string(jeep::AcceptanceOptions{}.min_directional_overlap) +
+            " and condition >= " + std::to_string(jeep::AcceptanceOptions{}.min_condition)}});
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -481,14 +468,14 @@ void odometry(Config c) {
     const auto& B = d.b();
     for (int single = 0; single < 2; ++single) {
       for (int threads : {1, c.threads}) {
-        jeep::OdometryResult r;
+        odometry::OdometryResult r;
         std::vector<double> secs;
         for (int rep = 0; rep < c.bench.repeats; ++rep) {
           const auto t0 = std::chrono::steady_clock::now();
           r = in_arena(threads, [&] {
-            return single ? jeep::run_single_odometry(A.frames, A.timestamps)
-                          : jeep::run_odometry(A.frames, A.timestamps, B.frames, B.timestamps,
-                                               d.truth);
+            return single ? odometry::run_single_odometry(A.frames, A.timestamps)
+                          : odometry::run_odometry(A.frames, A.timestamps, B.frames, B.timestamps,
+                                                   d.truth);
           });
           secs.push_back(seconds_since(t0));
         }
@@ -584,7 +571,7 @@ void registration(Config c) {
     const auto target_cloud = ulc::voxel_downsample(target_frame, 0.2).cloud;
     const auto queries = ulc::voxel_downsample(source_frame, 0.3).cloud;
     const ulc::PlaneCloud<float> kd(target_cloud);
-    jeep::LocalMap<float> map;
+    odometry::LocalMap<float> map;
     map.insert(target_cloud.points, ulc::Vec3d::Zero());
     std::vector<ulc::Vec3d> q;
     for (const auto& p : queries.points) q.push_back(initial * p.cast<double>());
@@ -602,7 +589,7 @@ void registration(Config c) {
            Cell::num(1e9 * t / q.size(), 0), std::to_string(found) + " matched within 1 m"});
     }
     const double insert = ulc_bench::median_seconds(c.bench.repeats, [&] {
-      jeep::LocalMap<float> m;
+      odometry::LocalMap<float> m;
       m.insert(target_cloud.points, ulc::Vec3d::Zero());
     });
     table.add_row({"LocalMap insert (planes fitted)", Cell::integer(c.threads),
@@ -636,8 +623,7 @@ int main(int argc, char** argv) {
       .value("--threads", ulc_bench::at_least(c.threads, 1))
       .value("--cache", ulc_bench::text(c.cache))
       .value("--png", ulc_bench::text(c.png_dir))
-      .flag("--one-way", [&] { c.one_way = true; })
-      .flag("--second-look", [&] { c.second_look = true; });
+      .flag("--one-way", [&] { c.one_way = true; });
   c.bench = args.parse(argc, argv,
                        "JEEP, scan-scan, odometry and ICP on simulated drives (modes: --accuracy "
                        "--separation --robustness --frames-sweep --odometry --registration)");

@@ -4,12 +4,10 @@
 //
 //   bench_rig [--scenarios ring-5x16,pitched-90,side-bpearl] [--seconds 10]
 //             [--stages terra,jeep,hots] [--decimation 1] [--seed 1] [--threads 2]
-//             [--no-route] [--no-cycles] [--synced-clocks] [--second-look] [--json]
+//             [--no-route] [--no-cycles] [--synced-clocks] [--json]
 // --synced-clocks: the pairs are told their clocks agree (the simulated rigs' do), so HOTS
 // neither estimates nor checks an offset; without it, a drive too short to pin the offset down
 // fails with time_offset_untrusted.
-// --second-look: JEEP's opt-in second look at refusals for the directional overlap alone
-// (include/jeep/second_look.hpp), for the pairs and the cycle checks.
 //
 // Per target: e_rot (deg) and e_trans (cm) against the simulator's mounts, the calibration's
 // status, the route, the clock offset error when HOTS ran, the cross links of the kept result
@@ -27,9 +25,9 @@
 #include <string>
 #include <vector>
 
+#include "pipeline/rig.hpp"
 #include "support/bench_args.hpp"
 #include "support/bench_util.hpp"
-#include "ulc/calibrate/rig.hpp"
 #include "ulc/core/pose_error.hpp"
 #include "ulc/sim/simulate.hpp"
 
@@ -47,7 +45,6 @@ struct Config {
   bool route = true;
   bool cycles = true;
   bool synced_clocks = false;  ///< --synced-clocks: no clock offset estimated (the rigs share one)
-  bool second_look = false;    ///< --second-look: JEEP's second look (opt-in)
   ulc_bench::Options bench;
 };
 
@@ -94,7 +91,6 @@ void bench(const Config& c) {
     ulc::RigOptions o;
     o.pair.stages = stages.stages;
     if (c.synced_clocks) o.pair.time_offset_s = 0.0;
-    o.pair.jeep.second_look.enabled = c.second_look;
     o.route = c.route;
     o.cycles = c.cycles;
     if (!c.bench.json)
@@ -117,7 +113,8 @@ void bench(const Config& c) {
       const auto& lidar = d.lidars[t.lidar];
       const ulc::Isometry3d truth = base.T_vehicle_lidar.inverse() * lidar.T_vehicle_lidar;
       const ulc::PoseError e = ulc::pose_error(truth, t.result.T_base_target);
-      const bool hots_ran = t.result.hots && t.result.hots->status == "ok";
+      const bool hots_ran = t.result.hots && t.result.hots->run == ulc::HotsRun::refined &&
+                            t.result.hots->status == hots::RefineStatus::ok;
       // t_base = t_target + offset; each LiDAR's own clock is t_true - clock_offset.
       const double true_offset = lidar.clock_offset_s - base.clock_offset_s;
       const bool bar = t.ok() && e.rotation_deg < 0.1 && e.translation_m < 0.02;
@@ -189,12 +186,10 @@ int main(int argc, char** argv) {
       .value("--threads", ulc_bench::at_least(c.threads, 1))
       .flag("--no-route", [&] { c.route = false; })
       .flag("--no-cycles", [&] { c.cycles = false; })
-      .flag("--synced-clocks", [&] { c.synced_clocks = true; })
-      .flag("--second-look", [&] { c.second_look = true; });
+      .flag("--synced-clocks", [&] { c.synced_clocks = true; });
   c.bench = args.parse(argc, argv,
                        "whole rigs with no initial guess (options --scenarios --seconds --stages "
-                       "--decimation --seed --threads --no-route --no-cycles --synced-clocks "
-                       "--second-look)");
+                       "--decimation --seed --threads --no-route --no-cycles --synced-clocks)");
   bench(c);
   return 0;
 }

@@ -1,6 +1,6 @@
 // `ulc calibrate`: the extrinsic of every target LiDAR against the base, through the stages asked
 // for (terra, jeep, hots), written as the result file of docs/design.md and summarised on stdout.
-// The targets form a rig (ulc/calibrate/rig.hpp): a target that fails against the base is routed
+// The targets form a rig (pipeline/rig.hpp): a target that fails against the base is routed
 // through one that succeeded, and with two targets or more the cycles between them are closed.
 #include <tbb/task_arena.h>
 
@@ -18,10 +18,10 @@
 #include "fused_cloud.hpp"
 #include "initial_extrinsic.hpp"
 #include "lidar_input.hpp"
+#include "pipeline/calibrate.hpp"
+#include "pipeline/result_entry.hpp"
+#include "pipeline/rig.hpp"
 #include "progress.hpp"
-#include "ulc/calibrate.hpp"
-#include "ulc/calibrate/result_entry.hpp"
-#include "ulc/calibrate/rig.hpp"
 #include "ulc/io/result_file.hpp"
 #include "ulc/io/result_yaml.hpp"
 
@@ -52,10 +52,6 @@ class StageProgress {
 std::vector<Stage> stages_option(const cli::Args& args) {
   const ParsedStages parsed = parse_stages(args.get("stages", "terra,jeep,hots"));
   if (!parsed.ok()) throw cli::UsageError("calibrate: option '--stages': " + parsed.error);
-  for (const Stage s : parsed.stages)
-    if (!stage_available(s))
-      throw cli::UsageError(std::string("calibrate: option '--stages': stage '") + to_string(s) +
-                            "' is not available in this build");
   return parsed.stages;
 }
 
@@ -171,10 +167,6 @@ int run_calibrate(int argc, char** argv) {
             "(for short drives that cannot pin one down)")
       .flag("no-route",
             "do not calibrate a failed target through another target that did calibrate")
-      .flag("second-look",
-            "JEEP: give a refusal for the off-ground overlap alone a second look (both "
-            "registration directions agree, and starts around the result come back to it); "
-            "accepts more sparse pairs (VLP-16, Avia), at a small risk of accepting a wrong fit")
       .flag("no-cycles", "do not check the cycles base -> i -> j -> base (two targets or more)")
       .flag("quiet", "no progress on stderr")
       .flag("help", "show this help");
@@ -209,11 +201,10 @@ int run_calibrate(int argc, char** argv) {
                           " needs an initial extrinsic: --initial \"x y z roll pitch yaw\" or "
                           "--initial FILE.json");
   if (args.has("synced-clocks")) options.time_offset_s = 0.0;
-  options.jeep.second_look.enabled = args.has("second-look");
   const auto frame_index =
       static_cast<std::size_t>(args.get_int("frame-index", 0, 0, 1000000000LL));
-  options.jeep.frames = static_cast<std::size_t>(
-      args.get_int("frames", static_cast<long long>(options.jeep.frames), 1, 100000));
+  options.tuning.jeep.frames = static_cast<std::size_t>(
+      args.get_int("frames", static_cast<long long>(options.tuning.jeep.frames), 1, 100000));
   std::optional<tbb::task_arena> arena;
   if (args.has("threads")) arena.emplace(static_cast<int>(args.get_int("threads", 1, 1, 1024)));
   if (!run_terra) (void)parse_initial(args.get("initial"), "", "");  // fail before any loading
@@ -232,7 +223,7 @@ int run_calibrate(int argc, char** argv) {
   const LidarInput& base = *inputs.front();
 
   // The frames each stage needs, counted from frame_index; the base's are shared by all targets.
-  const std::size_t base_count = run_hots ? kAllFrames : run_jeep ? options.jeep.frames : 1;
+  const std::size_t base_count = run_hots ? kAllFrames : run_jeep ? options.tuning.jeep.frames : 1;
   const bool quiet = args.has("quiet");
   const LoadedFrames base_frames = base.load(frame_index, base_count);
   require_frame(base, base_frames, frame_index);

@@ -8,13 +8,13 @@
 //     every stage key of docs/design.md ("terra", "jeep", "odometry", "hots", "total"), 0 for a
 //     stage that did not run.
 //   - Angles in the stage objects are degrees, distances metres, times seconds.
-// This is an I/O-side header (it builds ulc::io::Json): unlike ulc/calibrate.hpp it is not part
-// of the -fno-exceptions promise.
+// This is an I/O-side header (it builds ulc::io::Json): unlike pipeline/calibrate.hpp it is not
+// part of the -fno-exceptions promise.
 #pragma once
 
 #include <string>
 
-#include "ulc/calibrate/pair_calibration.hpp"
+#include "pipeline/pair_calibration.hpp"
 #include "ulc/core/lie.hpp"
 #include "ulc/io/json.hpp"
 #include "ulc/io/json_eigen.hpp"
@@ -39,7 +39,7 @@ inline io::Json local_map_stats(const LocalMapStats& m) {
   j["stacked_points"] = m.stacked_points;
   j["points"] = m.points;
   j["voxel_m"] = m.voxel_used;
-  j["odometry_status"] = m.odometry_status;
+  j["odometry_status"] = odometry::to_string(m.odometry_status);
   j["odometry_reason"] = m.odometry_reason;
   j["odometry_failed_steps"] = m.odometry_failed_steps;
   j["seconds"] = m.seconds;
@@ -54,7 +54,7 @@ inline io::Json local_map_stats(const LocalMapStats& m) {
 inline io::Json terra_to_json(const TerraReport& t) {
   using result_detail::stage_stats;
   io::Json j = io::Json::object();
-  j["status"] = t.status;
+  j["status"] = terra::to_string(t.status);
   j["reason"] = t.reason;
   j["frame_index"] = t.frame_index;
   j["rpy_deg"] = io::vector_to_json(rpy_from_rotation(t.rotation) * result_detail::kDegPerRad);
@@ -75,22 +75,24 @@ inline io::Json terra_to_json(const TerraReport& t) {
   j["rotations_evaluated"] = t.stats.rotations();
   j["descriptor_seconds"] = t.stats.descriptor_seconds;
   j["seconds"] = t.seconds;
-  j["source"] = t.source;
+  j["source"] = to_string(t.source);
   j["source_reason"] = t.source_reason;
   if (t.frames_mask_count) {
     j["frames_mask_count"] = *t.frames_mask_count;
-    j["frames_status"] = t.frames_status;
+    j["frames_status"] = terra::to_string(t.frames_status);
   }
   if (t.base_map) j["base_map"] = result_detail::local_map_stats(*t.base_map);
   if (t.target_map) j["target_map"] = result_detail::local_map_stats(*t.target_map);
   io::Json hypotheses = io::Json::array();
   for (const TerraHypothesis& h : t.hypotheses) {
     io::Json e = io::Json::object();
-    e["source"] = h.source;
+    e["source"] = to_string(h.source);
     e["rpy_deg"] = io::vector_to_json(rpy_from_rotation(h.rotation) * result_detail::kDegPerRad);
     e["distance"] = h.distance;
     e["mask_count"] = h.mask_count;
-    e["outcome"] = h.outcome;
+    e["outcome"] = h.status == CalibrateStatus::ok
+                       ? std::string("ok")
+                       : std::string(to_string(h.status)) + ": " + h.reason;
     e["seconds"] = h.seconds;
     hypotheses.push_back(std::move(e));
   }
@@ -102,12 +104,12 @@ inline io::Json terra_to_json(const TerraReport& t) {
 /// stages.jeep: rounds, status and the last calibration phase's cost and inliers.
 inline io::Json jeep_to_json(const JeepReport& r) {
   io::Json j = io::Json::object();
-  j["status"] = r.status;
+  j["status"] = jeep::to_string(r.status);
   j["reason"] = r.reason;
   j["rounds"] = r.rounds;
   j["frame_pairs"] = r.frame_pairs;
   j["initial_T_base_target"] = io::matrix_to_json(r.initial.matrix());
-  j["calibration_status"] = r.calibration_status;
+  j["calibration_status"] = to_string(r.calibration_status);
   j["final_cost"] = r.final_cost;
   j["final_inliers"] = r.final_inliers;
   j["final_rmse_m"] = r.final_rmse;
@@ -120,18 +122,21 @@ inline io::Json jeep_to_json(const JeepReport& r) {
   j["two_way_gap_deg"] = r.two_way_gap_rotation * result_detail::kDegPerRad;
   j["start_basins"] = r.start_basins;
   j["start_chosen"] = r.start_chosen;
-  if (r.second_look) {
-    io::Json look = io::Json::object();
-    look["passed"] = r.second_look_passed;
-    look["returned"] = r.second_look_returned;
-    look["starts"] = r.second_look_starts;
-    j["second_look"] = look;
-  } else {
-    j["second_look"] = nullptr;
-  }
   j["judged_by_hots"] = r.judged_by_hots;
   j["seconds"] = r.seconds;
   return j;
+}
+
+/// stages.hots.status: hots::refine's status, or "skipped" / "not_run" when it did not run.
+inline std::string hots_status_text(const HotsReport& h) {
+  switch (h.run) {
+    case HotsRun::skipped:
+      return "skipped";
+    case HotsRun::odometry_failed:
+      return "not_run";
+    default:
+      return hots::to_string(h.status);
+  }
 }
 
 /// stages.hots: the odometry that fed it, the graph's and the time synchronisation's statistics
@@ -139,9 +144,9 @@ inline io::Json jeep_to_json(const JeepReport& r) {
 inline io::Json hots_to_json(const HotsReport& h) {
   const hots::RefineStatistics& s = h.statistics;
   io::Json j = io::Json::object();
-  j["status"] = h.status;
+  j["status"] = hots_status_text(h);
   j["reason"] = h.reason;
-  j["odometry_status"] = h.odometry_status;
+  j["odometry_status"] = odometry::to_string(h.odometry_status);
   j["odometry_reason"] = h.odometry_reason;
   j["odometry_failed_steps"] = h.odometry_failed_steps;
   j["frames_base"] = h.frames_base;
