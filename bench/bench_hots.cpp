@@ -22,7 +22,7 @@
 //   they step where a line meets an arc). --no-traffic: no oncoming cars.
 //   --jeep-decides: a failed JEEP ends the run (by default, as in the pipeline, a JEEP that was
 //   rejected or did not settle hands its extrinsic to HOTS, whose cross links judge it:
-//   CalibrateOptions::hots_judges_jeep; the stderr line says "judged").
+//   CalibrateOptions::tuning.hypotheses.hots_judges_jeep; the stderr line says "judged").
 //
 // Each run simulates the drive with seed = run index + 1 (runs --first-run onwards), disturbs the
 // truth by 5 deg about a random axis and 2 m in a random direction (seeded by the run), runs JEEP
@@ -61,11 +61,11 @@
 
 #include "../tests/jeep/jeep_test_util.hpp"
 #include "hots/hots.hpp"
-#include "jeep/run_odometry.hpp"
+#include "odometry/run_odometry.hpp"
+#include "pipeline/calibrate.hpp"
+#include "pipeline/pipeline.hpp"
 #include "support/bench_util.hpp"
 #include "support/curve_png.hpp"
-#include "ulc/calibrate.hpp"
-#include "ulc/calibrate/pipeline.hpp"
 #include "ulc/core/pose_error.hpp"
 #include "ulc/sim/simulate.hpp"
 
@@ -289,8 +289,8 @@ Run one_run(const std::string& scenario, double offset_s, std::size_t run, const
     ulc::CalibrateOptions o;
     o.stages = {ulc::Stage::jeep};
     o.initial = initial;
-    if (c.layers > 0) o.hots.hierarchy.layers = c.layers;
-    for (const auto& setting : c.hots_settings) apply_hots_setting(o.hots, setting);
+    if (c.layers > 0) o.tuning.hots.hierarchy.layers = c.layers;
+    for (const auto& setting : c.hots_settings) apply_hots_setting(o.tuning.hots, setting);
     const auto j = ulc::calibrate_pair(a.frames, a.timestamps, b.frames, times_b, o);
     out.status = ulc::to_string(j.status);
     out.jeep_ok = j.success;
@@ -298,13 +298,14 @@ Run one_run(const std::string& scenario, double offset_s, std::size_t run, const
     out.jeep_error = ulc::pose_error(truth, C);
     out.hots_error = out.sync_error = out.jeep_error;
     out.dt_error_s = out.sync_dt_error_s = true_offset;
-    // As the pipeline does (CalibrateOptions::hots_judges_jeep): a JEEP that was rejected or
-    // did not settle hands its extrinsic to HOTS, whose cross links judge it.
+    // As the pipeline does (CalibrateOptions::tuning.hypotheses.hots_judges_jeep): a JEEP that was
+    // rejected or did not settle hands its extrinsic to HOTS, whose cross links judge it.
     out.judged_by_hots = !j.success && c.hots_judges_jeep && j.jeep &&
                          ulc::calibrate_detail::hots_can_judge(*j.jeep);
     if (!j.success && !out.judged_by_hots) return;
     auto t0 = std::chrono::steady_clock::now();
-    const auto odo = jeep::run_odometry(a.frames, a.timestamps, b.frames, times_b, C, o.odometry);
+    const auto odo =
+        odometry::run_odometry(a.frames, a.timestamps, b.frames, times_b, C, o.tuning.odometry);
     out.odometry_s = seconds_since(t0);
     if (!ulc::calibrate_detail::odometry_usable(odo)) {
       out.status = std::string("odometry_") + jeep::to_string(odo.status);
@@ -313,8 +314,9 @@ Run one_run(const std::string& scenario, double offset_s, std::size_t run, const
     out.ate_odometry = ate(d, 0, odo.poses_a);
     out.ate_aligned_odometry = ate_aligned(d, 0, odo.poses_a);
     t0 = std::chrono::steady_clock::now();
-    const auto h = hots::refine(a.frames, a.timestamps, odo.poses_a, b.frames, times_b, odo.poses_b,
-                                C, o.hots);
+    const auto h =
+        hots::refine(ulc::make_sequence(a.frames, a.timestamps, odo.poses_a),
+                     ulc::make_sequence(b.frames, times_b, odo.poses_b), C, o.tuning.hots);
     out.hots_s = seconds_since(t0);
     out.status = std::string("hots_") + hots::to_string(h.status);
     out.hots_ok = h.ok();

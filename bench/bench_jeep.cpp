@@ -41,8 +41,8 @@
 
 #include "../tests/jeep/jeep_test_util.hpp"
 #include "jeep/jeep.hpp"
-#include "jeep/run_odometry.hpp"
 #include "jeep/scan_scan.hpp"
+#include "odometry/run_odometry.hpp"
 #include "support/bench_util.hpp"
 #include "support/heatmap_png.hpp"
 #include "ulc/core/pose_error.hpp"
@@ -98,7 +98,7 @@ struct FrameWindow {
 
 struct Drive {
   ulc::sim::Dataset data;
-  std::vector<jeep::FramePair> pairs;  ///< every pair of the drive
+  std::vector<odometry::FramePair> pairs;  ///< every pair of the drive
   Isometry3d truth = Isometry3d::Identity();
   const ulc::sim::LidarRecording& a() const { return data.lidars[0]; }
   const ulc::sim::LidarRecording& b() const { return data.lidars[1]; }
@@ -114,8 +114,8 @@ Drive load_drive(const std::string& scenario, const Config& c) {
   Drive d;
   d.data = jeep_test::cached(spec, c.cache);
   d.truth = d.data.pairs.at(0).T_base_target;
-  const double period = jeep::frame_period(d.a().timestamps);
-  d.pairs = jeep::pair_frames(d.a().timestamps, d.b().timestamps, 0.0, 0.5 * period);
+  const double period = odometry::frame_period(d.a().timestamps);
+  d.pairs = odometry::pair_frames(d.a().timestamps, d.b().timestamps, 0.0, 0.5 * period);
   return d;
 }
 
@@ -467,14 +467,14 @@ void odometry(Config c) {
     const auto& B = d.b();
     for (int single = 0; single < 2; ++single) {
       for (int threads : {1, c.threads}) {
-        jeep::OdometryResult r;
+        odometry::OdometryResult r;
         std::vector<double> secs;
         for (int rep = 0; rep < c.bench.repeats; ++rep) {
           const auto t0 = std::chrono::steady_clock::now();
           r = in_arena(threads, [&] {
-            return single ? jeep::run_single_odometry(A.frames, A.timestamps)
-                          : jeep::run_odometry(A.frames, A.timestamps, B.frames, B.timestamps,
-                                               d.truth);
+            return single ? odometry::run_single_odometry(A.frames, A.timestamps)
+                          : odometry::run_odometry(A.frames, A.timestamps, B.frames, B.timestamps,
+                                                   d.truth);
           });
           secs.push_back(seconds_since(t0));
         }
@@ -570,7 +570,7 @@ void registration(Config c) {
     const auto target_cloud = ulc::voxel_downsample(target_frame, 0.2).cloud;
     const auto queries = ulc::voxel_downsample(source_frame, 0.3).cloud;
     const ulc::PlaneCloud<float> kd(target_cloud);
-    jeep::LocalMap<float> map;
+    odometry::LocalMap<float> map;
     map.insert(target_cloud.points, ulc::Vec3d::Zero());
     std::vector<ulc::Vec3d> q;
     for (const auto& p : queries.points) q.push_back(initial * p.cast<double>());
@@ -588,7 +588,7 @@ void registration(Config c) {
            Cell::num(1e9 * t / q.size(), 0), std::to_string(found) + " matched within 1 m"});
     }
     const double insert = ulc_bench::median_seconds(c.bench.repeats, [&] {
-      jeep::LocalMap<float> m;
+      odometry::LocalMap<float> m;
       m.insert(target_cloud.points, ulc::Vec3d::Zero());
     });
     table.add_row({"LocalMap insert (planes fitted)", Cell::integer(c.threads),

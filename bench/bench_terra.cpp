@@ -40,9 +40,9 @@
 #include <vector>
 
 #include "../tests/terra/terra_test_util.hpp"
+#include "pipeline/calibrate.hpp"
 #include "support/bench_util.hpp"
 #include "terra/terra.hpp"
-#include "ulc/calibrate.hpp"
 #include "ulc/core/pose_error.hpp"
 #include "ulc/sim/sim.hpp"
 
@@ -458,7 +458,7 @@ int run_accuracy(const ulc_bench::Options& options, const AccuracyOptions& acc) 
 }
 
 // ---------------------------------------------------------------------------------------------
-// --maps: TERRA on frames vs on local maps (ulc/calibrate/map_terra.hpp) vs the automatic choice,
+// --maps: TERRA on frames vs on local maps (pipeline/map_terra.hpp) vs the automatic choice,
 // each through ulc::calibrate_pair with the terra stage alone.
 
 struct MapsOptions {
@@ -592,9 +592,9 @@ int run_maps(const ulc_bench::Options& options, const MapsOptions& mo) {
         const Window& w = windows[k];
         ulc::CalibrateOptions co;
         co.stages = {ulc::Stage::terra};
-        co.terra_source = source;
-        co.terra_maps.window_s = mo.window_s;
-        co.terra_maps_below_mask = mo.below_mask;
+        co.tuning.terra_source.source = source;
+        co.tuning.terra_source.maps.window_s = mo.window_s;
+        co.tuning.terra_source.maps_below_mask = mo.below_mask;
         const auto r = in_arena(mo.threads, [&] {
           return ulc::calibrate_pair(w.base, w.base_times, w.target, w.target_times, co);
         });
@@ -606,7 +606,7 @@ int run_maps(const ulc_bench::Options& options, const MapsOptions& mo) {
         ok5 += err < 5.0;
         ok10 += err < ulc::kRotationInitMaxRotationDeg;
         seconds += r.timing_s.terra;
-        const bool maps = r.terra && r.terra->source == "maps";
+        const bool maps = r.terra && r.terra->source == ulc::TerraSource::maps;
         chose_maps += maps;
         if (!options.json)
           std::cerr << name << " start " << k << " " << label << ": e_rot " << fmt(err, 2)
@@ -618,9 +618,10 @@ int run_maps(const ulc_bench::Options& options, const MapsOptions& mo) {
                     << (r.terra && r.terra->base_map ? r.terra->base_map->points : 0) << "/"
                     << (r.terra && r.terra->target_map ? r.terra->target_map->points : 0)
                     << ", odo "
-                    << (r.terra && r.terra->target_map ? r.terra->base_map->odometry_status + "/" +
-                                                             r.terra->target_map->odometry_status
-                                                       : std::string("-"))
+                    << (r.terra && r.terra->target_map
+                            ? std::string(odometry::to_string(r.terra->base_map->odometry_status)) +
+                                  "/" + odometry::to_string(r.terra->target_map->odometry_status)
+                            : std::string("-"))
                     << ", " << fmt(r.timing_s.terra, 2) << " s\n";
       }
       const double n = double(windows.size());

@@ -9,12 +9,12 @@
 // options) starts from the true rotation, from the paper's disturbance (5 deg about a random
 // axis, 2 m), and from the true rotation turned by 10, 20, 45, 90 and 166 deg of yaw, each with
 // zero translation. Where JEEP accepts, or fails in a way the pipeline hands to HOTS (rejected,
-// not settled: CalibrateOptions::hots_judges_jeep), the pipeline's odometry and HOTS run with the
-// cross-link trust rule switched off (RefineOptions::min_cross_link_ratio = 0) so that every start
-// shows what HOTS would have returned; the table gives the cross links agreeing with the start,
-// kept, and attempted (cross_links.hpp), the verdict the default rule would give (confirmed /
-// unconfirmed), and the truth (right: HOTS's extrinsic within the paper's success threshold,
-// 1 deg and 10 cm). The figure of merit: the largest agreeing share among wrong results
+// not settled: CalibrateOptions::tuning.hypotheses.hots_judges_jeep), the pipeline's odometry and
+// HOTS run with the cross-link trust rule switched off (RefineOptions::min_cross_link_ratio = 0) so
+// that every start shows what HOTS would have returned; the table gives the cross links agreeing
+// with the start, kept, and attempted (cross_links.hpp), the verdict the default rule would give
+// (confirmed / unconfirmed), and the truth (right: HOTS's extrinsic within the paper's success
+// threshold, 1 deg and 10 cm). The figure of merit: the largest agreeing share among wrong results
 // against the smallest among right ones (the rule's margin), printed after the table.
 #include <tbb/task_arena.h>
 #include <algorithm>
@@ -26,10 +26,10 @@
 
 #include "../tests/jeep/jeep_test_util.hpp"
 #include "hots/hots.hpp"
-#include "jeep/run_odometry.hpp"
+#include "odometry/run_odometry.hpp"
+#include "pipeline/calibrate.hpp"
+#include "pipeline/pipeline.hpp"
 #include "support/bench_util.hpp"
-#include "ulc/calibrate.hpp"
-#include "ulc/calibrate/pipeline.hpp"
 #include "ulc/core/pose_error.hpp"
 
 namespace {
@@ -106,33 +106,34 @@ void bench(const Config& c) {
                                 ulc::to_string(j.status),
                                 Cell::num(je.rotation_deg, 3),
                                 Cell::num(100.0 * je.translation_m, 2)};
-          // As the pipeline does (CalibrateOptions::hots_judges_jeep): a JEEP that was rejected
-          // or did not settle hands its extrinsic to HOTS.
+          // As the pipeline does (CalibrateOptions::tuning.hypotheses.hots_judges_jeep): a JEEP
+          // that was rejected or did not settle hands its extrinsic to HOTS.
           if (!j.success && !(j.jeep && ulc::calibrate_detail::hots_can_judge(*j.jeep))) {
             for (int k = 0; k < 7; ++k) row.push_back("-");
             table.add_row(row);
             return;
           }
           const Isometry3d C = j.jeep->extrinsic;
-          const auto odo =
-              jeep::run_odometry(a.frames, a.timestamps, b.frames, b.timestamps, C, o.odometry);
+          const auto odo = odometry::run_odometry(a.frames, a.timestamps, b.frames, b.timestamps, C,
+                                                  o.tuning.odometry);
           if (!ulc::calibrate_detail::odometry_usable(odo)) {
             row.push_back(std::string("odometry_") + jeep::to_string(odo.status));
             for (int k = 0; k < 6; ++k) row.push_back("-");
             table.add_row(row);
             return;
           }
-          hots::RefineOptions ho = o.hots;
+          hots::RefineOptions ho = o.tuning.hots;
           ho.min_cross_link_ratio = 0.0;  // what HOTS would return without the rule
-          const auto h = hots::refine(a.frames, a.timestamps, odo.poses_a, b.frames, b.timestamps,
-                                      odo.poses_b, C, ho);
+          const auto h =
+              hots::refine(ulc::make_sequence(a.frames, a.timestamps, odo.poses_a),
+                           ulc::make_sequence(b.frames, b.timestamps, odo.poses_b), C, ho);
           const auto he = ulc::pose_error(truth, h.extrinsic);
           const auto& st = h.statistics;
           const double share = st.cross_links_attempted
                                    ? static_cast<double>(st.cross_links_agreeing) /
                                          static_cast<double>(st.cross_links_attempted)
                                    : 0.0;
-          const bool confirmed = hots::hots_detail::links_confirm(st, o.hots);
+          const bool confirmed = hots::hots_detail::links_confirm(st, o.tuning.hots);
           const bool right = ulc::is_calibration_success(he);
           (right ? m.right : m.wrong) += 1;
           if (right) {

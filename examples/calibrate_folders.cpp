@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "ulc/calibrate.hpp"
+#include "pipeline/calibrate.hpp"
 #include "ulc/io/result_entry.hpp"
 #include "ulc/io/result_file.hpp"
 #include "ulc/io/sequence.hpp"
@@ -64,8 +64,8 @@ int main(int argc, char** argv) {
     options.progress = [](const std::string& stage, double fraction) {
       if (fraction == 1.0) std::fprintf(stderr, "%s done\n", stage.c_str());
     };
-    const Frames a = load_first(base, options.jeep.frames + 2);
-    const Frames b = load_first(target, options.jeep.frames + 2);
+    const Frames a = load_first(base, options.tuning.jeep.frames + 2);
+    const Frames b = load_first(target, options.tuning.jeep.frames + 2);
     const ulc::PairCalibration c =
         ulc::calibrate_pair(a.clouds, a.times, b.clouds, b.times, options);
     const ulc::io::PairResult entry = ulc::io::to_pair_result(c, base.name(), target.name());

@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "ulc/calibrate.hpp"
+#include "pipeline/calibrate.hpp"
 #include "ulc/core/pose_error.hpp"
 #include "ulc/sim/scenario.hpp"
 #include "ulc/sim/simulate.hpp"

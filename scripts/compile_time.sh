@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Compile time of a user's file that calls ulc::calibrate_pair on its own point struct
 # (bench/compile_time/user_calibrate.cpp), at -O2 on one core, with the compiler's peak memory:
-#   1. through ulc/calibrate.hpp, the pipeline compiled once elsewhere (ulc::calibrate);
-#   2. the pipeline itself, compiled once (ulc/calibrate/implementation.hpp): what ulc::calibrate
+#   1. through pipeline/calibrate.hpp, the pipeline compiled once elsewhere (ulc::calibrate);
+#   2. the pipeline itself, compiled once (pipeline/implementation.hpp): what ulc::calibrate
 #      costs, paid once per build;
 #   3. the baseline of the same run: calibrate_pair_in_place, every stage compiled for the
 #      user's type in the user's file (how every such file compiled before ulc::calibrate).
@@ -21,8 +21,8 @@ measure() {  # label, then the compiler arguments
   printf '%-44s %8.1f s %8.0f MiB\n' "$label" "$seconds" "$((kib / 1024))"
 }
 printf '%-44s %10s %12s\n' "file" "wall" "peak memory"
-measure "user file via ulc/calibrate.hpp" bench/compile_time/user_calibrate.cpp -o "$out/a.o"
-printf '#include "ulc/calibrate/implementation.hpp"\n' >"$out/impl.cpp"
+measure "user file via pipeline/calibrate.hpp" bench/compile_time/user_calibrate.cpp -o "$out/a.o"
+printf '#include "pipeline/implementation.hpp"\n' >"$out/impl.cpp"
 measure "the pipeline, once (ulc::calibrate)" "$out/impl.cpp" -o "$out/b.o"
 if [ "${1:-}" != "--skip-baseline" ]; then
   measure "baseline: user file, stages in place" -DULC_IN_PLACE \

@@ -1,6 +1,6 @@
 // `ulc calibrate`: the extrinsic of every target LiDAR against the base, through the stages asked
 // for (terra, jeep, hots), written as the result file of docs/design.md and summarised on stdout.
-// The targets form a rig (ulc/calibrate/rig.hpp): a target that fails against the base is routed
+// The targets form a rig (pipeline/rig.hpp): a target that fails against the base is routed
 // through one that succeeded, and with two targets or more the cycles between them are closed.
 #include <tbb/task_arena.h>
 
@@ -18,9 +18,9 @@
 #include "fused_cloud.hpp"
 #include "initial_extrinsic.hpp"
 #include "lidar_input.hpp"
+#include "pipeline/calibrate.hpp"
+#include "pipeline/rig.hpp"
 #include "progress.hpp"
-#include "ulc/calibrate.hpp"
-#include "ulc/calibrate/rig.hpp"
 #include "ulc/io/result_entry.hpp"
 #include "ulc/io/result_file.hpp"
 #include "ulc/io/result_yaml.hpp"
@@ -52,10 +52,6 @@ class StageProgress {
 std::vector<Stage> stages_option(const std::string& text) {
   const ParsedStages parsed = parse_stages(text);
   if (!parsed.ok()) throw UsageError("calibrate: option '--stages': " + parsed.error);
-  for (const Stage s : parsed.stages)
-    if (!stage_available(s))
-      throw UsageError(std::string("calibrate: option '--stages': stage '") + to_string(s) +
-                       "' is not available in this build");
   return parsed.stages;
 }
 
@@ -161,7 +157,7 @@ int run_calibrate(int argc, char** argv) {
   long long frame_index_arg = 0, frames = 0, threads = 0;
   bool synced_clocks = false, no_route = false, no_cycles = false, quiet = false;
   CalibrateOptions options;
-  frames = static_cast<long long>(options.jeep.frames);
+  frames = static_cast<long long>(options.tuning.jeep.frames);
   app.add_option(
          "--base", base_spec,
          "the base LiDAR: a frame folder, a cloud file, or FILE:TOPIC of a recording (.bag, "
@@ -232,7 +228,7 @@ int run_calibrate(int argc, char** argv) {
                      "--initial FILE.json");
   if (synced_clocks) options.time_offset_s = 0.0;
   const auto frame_index = static_cast<std::size_t>(frame_index_arg);
-  options.jeep.frames = static_cast<std::size_t>(frames);
+  options.tuning.jeep.frames = static_cast<std::size_t>(frames);
   std::optional<tbb::task_arena> arena;
   if (threads_option->count() > 0) arena.emplace(static_cast<int>(threads));
   if (!run_terra) (void)parse_initial(initial, "", "");  // fail before any loading
@@ -246,7 +242,7 @@ int run_calibrate(int argc, char** argv) {
   const LidarInput& base = *inputs.front();
 
   // The frames each stage needs, counted from frame_index; the base's are shared by all targets.
-  const std::size_t base_count = run_hots ? kAllFrames : run_jeep ? options.jeep.frames : 1;
+  const std::size_t base_count = run_hots ? kAllFrames : run_jeep ? options.tuning.jeep.frames : 1;
   const LoadedFrames base_frames = base.load(frame_index, base_count);
   require_frame(base, base_frames, frame_index);
 

@@ -10,7 +10,7 @@
 #include <set>
 
 #include "command_line.hpp"
-#include "jeep/frame_pairing.hpp"
+#include "odometry/frame_pairing.hpp"
 #include "ulc/bags/cloud_topic.hpp"
 #include "ulc/bags/recording.hpp"
 #include "ulc/io/decoded_cloud.hpp"
@@ -70,7 +70,7 @@ class FolderInput : public LidarInput {
   double period() const override {
     std::vector<double> t;
     for (const std::size_t i : selected_) t.push_back(seq_.frame(i).timestamp);
-    return jeep::frame_period(t);
+    return odometry::frame_period(t);
   }
 
  private:

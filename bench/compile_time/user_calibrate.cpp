@@ -1,14 +1,14 @@
 // A user's file that calibrates its own point type: what scripts/compile_time.sh compiles.
-// By default through ulc/calibrate.hpp (the pipeline compiled once elsewhere: ulc::calibrate);
+// By default through pipeline/calibrate.hpp (the pipeline compiled once elsewhere: ulc::calibrate);
 // with -DULC_IN_PLACE through calibrate_pair_in_place, every stage compiled for this type (the
 // baseline of the same run).
 #include <cstdint>
 #include <vector>
 
 #ifdef ULC_IN_PLACE
-#include "ulc/calibrate/pipeline.hpp"
+#include "pipeline/pipeline.hpp"
 #else
-#include "ulc/calibrate.hpp"
+#include "pipeline/calibrate.hpp"
 #endif
 
 struct VehiclePoint {

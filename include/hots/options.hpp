@@ -122,11 +122,6 @@ struct SequenceExtrinsicOptions {
   double source_voxel = 0.8;     ///< m, each target frame's thinning
   double target_voxel = 0.3;     ///< m, each base submap's thinning
   std::size_t frame_stride = 4;  ///< every n-th target frame (2.5 per second at 10 Hz)
-  /// hots::refine deskews those frames afresh with the base's refined trajectory through C at
-  /// the starting dt, instead of b's own (unrefined) odometry: a sweep deskewed with a wrong
-  /// velocity is displaced along the motion, which reads as a clock offset. Off by default:
-  /// measured mixed (docs/BENCHMARKS.md, "Deskewing the target from the base").
-  bool deskew_from_base = false;
   ulc::PlaneCloudOptions planes;
   /// Coarse to fine from HOTS's start (millimetres to a few centimetres away).
   std::vector<ulc::RegistrationOptions> stages = default_stages();

@@ -54,9 +54,6 @@
 //     without a Tele were the same two of 85 as with the six directions alone, and with a Tele
 //     2 of 27 (1 before)
 //     (docs/BENCHMARKS.md, "The acceptance rule off the ground").
-//   - A refusal for the off-ground overlap alone can get a second look (second_look.hpp,
-//     opt-in: JeepOptions::second_look), which accepts the sparse pairs' right answers at a
-//     small risk of accepting two unrelated streets.
 //   - min_condition is the registration's own degeneracy threshold: an alignment resting on
 //     the ground alone is not a calibration. bench_jeep --separation measures both
 //     distributions on the paper's pairs (docs/design.md: measure, do not guess).

@@ -18,8 +18,7 @@
 //   - Settled: the round changed C by less than settle_translation / settle_rotation and every
 //     pose of a by less than the same. No settling within max_rounds (the paper: "exceeding a
 //     certain number of iterations is a failure"; 10) gives status not_converged.
-//   - Acceptance (status rejected otherwise), see acceptance.hpp; optionally with a second
-//     look at a refusal for the off-ground overlap alone (second_look.hpp).
+//   - Acceptance (status rejected otherwise), see acceptance.hpp.
 //   - Nothing here throws or prints; the result is the same for any number of threads.
 #pragma once
 
@@ -31,46 +30,22 @@
 #include <vector>
 
 #include "jeep/acceptance.hpp"
-#include "jeep/frame_pairing.hpp"
 #include "jeep/map_registration.hpp"
-#include "jeep/odometry.hpp"
 #include "jeep/options.hpp"
-#include "jeep/run_odometry.hpp"
-#include "jeep/scan_preparation.hpp"
-#include "jeep/second_look.hpp"
 #include "jeep/start_search.hpp"
+#include "jeep/status.hpp"
 #include "jeep/two_way.hpp"
+#include "odometry/frame_pairing.hpp"
+#include "odometry/odometry.hpp"
+#include "odometry/run_odometry.hpp"
+#include "odometry/scan_preparation.hpp"
 #include "ulc/core/lie.hpp"
 #include "ulc/core/point_traits.hpp"
 #include "ulc/core/types.hpp"
 
 namespace jeep {
 
-enum class JeepStatus {
-  ok,
-  not_converged,        ///< max_rounds without settling
-  rejected,             ///< settled, but the acceptance rule says the result is not trustworthy
-  registration_failed,  ///< the calibration phase or a pose step had too few correspondences
-  too_few_frames,       ///< no frame pair
-  invalid_input         ///< bad options, timestamps, counts or initial extrinsic
-};
-
-inline const char* to_string(JeepStatus s) {
-  switch (s) {
-    case JeepStatus::ok:
-      return "ok";
-    case JeepStatus::not_converged:
-      return "not_converged";
-    case JeepStatus::rejected:
-      return "rejected";
-    case JeepStatus::registration_failed:
-      return "registration_failed";
-    case JeepStatus::too_few_frames:
-      return "too_few_frames";
-    default:
-      return "invalid_input";
-  }
-}
+using ulc::Vec6d;
 
 /// What one round did.
 struct JeepRound {
@@ -87,15 +62,14 @@ struct JeepResult {
   JeepStatus status = JeepStatus::ok;
   const char* reason = "";
   Isometry3d extrinsic = Isometry3d::Identity();  ///< C = T_base_target
-  std::vector<FramePair> pairs;                   ///< the pairs used (indices into the inputs)
+  std::vector<odometry::FramePair> pairs;         ///< the pairs used (indices into the inputs)
   std::vector<Isometry3d> poses_a;                ///< per pair: P_a = T_mapa_a at a's timestamp
   std::vector<Isometry3d> poses_b;                ///< per pair: P_b = T_mapb_b at b's timestamp
   std::vector<Vec6d> twists;  ///< per pair: a's body twist over its sweep, per second
   int rounds = 0;
   RegistrationResult<double> calibration;  ///< the last calibration phase
   StartSearchReport start_search;          ///< the first calibration phase's start search
-  AcceptanceReport acceptance;             ///< accepted: by the rule or by the second look
-  SecondLookReport second_look;
+  AcceptanceReport acceptance;             ///< accepted: by acceptance.hpp's rule
   TwoWayResult two_way;  ///< the last step when JeepOptions::two_way (applied: it was used)
   std::vector<JeepRound> trace;
   /// The last round's maps (eq:build_map) at calibration.target_voxel, in the frames of
@@ -120,8 +94,8 @@ template <class FramesA, class FramesB>
 JeepResult run_jeep(const FramesA& frames_a, const std::vector<double>& times_a,
                     const FramesB& frames_b, const std::vector<double>& times_b,
                     const Isometry3d& initial, const JeepOptions& options = {},
-                    const ProgressFn& progress = {}) {
-  using S = ulc::traits::scalar_t<detail::frame_cloud_t<FramesA>>;
+                    const odometry::ProgressFn& progress = {}) {
+  using S = ulc::traits::scalar_t<odometry::detail::frame_cloud_t<FramesA>>;
   JeepResult result;
   result.extrinsic = initial;
   auto fail = [&](JeepStatus s, const char* why) {
@@ -129,23 +103,23 @@ JeepResult run_jeep(const FramesA& frames_a, const std::vector<double>& times_a,
     result.reason = why;
     return result;
   };
-  if (options.frames < 1 || options.max_rounds < 1 || !valid_odometry_options(options.odometry) ||
-      options.calibration.stages.empty() || options.refine_stages < 1 ||
-      !(options.default_period > 0.0))
+  if (options.frames < 1 || options.max_rounds < 1 ||
+      !odometry::valid_odometry_options(options.odometry) || options.calibration.stages.empty() ||
+      options.refine_stages < 1 || !(options.default_period > 0.0))
     return fail(JeepStatus::invalid_input, "bad options");
   if (frames_a.size() != times_a.size() || frames_b.size() != times_b.size())
     return fail(JeepStatus::invalid_input, "frame and timestamp counts differ");
-  if (!timestamps_usable(times_a) || !timestamps_usable(times_b))
+  if (!odometry::timestamps_usable(times_a) || !odometry::timestamps_usable(times_b))
     return fail(JeepStatus::invalid_input, "timestamps not finite and nondecreasing");
   if (!initial.matrix().allFinite())
     return fail(JeepStatus::invalid_input, "initial extrinsic not finite");
 
-  const OdometryOptions& odo = options.odometry;
-  double period_a = frame_period(times_a), period_b = frame_period(times_b);
+  const odometry::OdometryOptions& odo = options.odometry;
+  double period_a = odometry::frame_period(times_a), period_b = odometry::frame_period(times_b);
   if (!(period_a > 0.0)) period_a = options.default_period;
   if (!(period_b > 0.0)) period_b = period_a;
-  std::vector<FramePair> pairs =
-      pair_frames(times_a, times_b, odo.time_offset_s, odo.max_pair_gap * period_a);
+  std::vector<odometry::FramePair> pairs =
+      odometry::pair_frames(times_a, times_b, odo.time_offset_s, odo.max_pair_gap * period_a);
   if (pairs.empty()) return fail(JeepStatus::too_few_frames, "no frame of b near a frame of a");
   if (pairs.size() > options.frames) pairs.resize(options.frames);
   result.pairs = pairs;
@@ -160,17 +134,18 @@ JeepResult run_jeep(const FramesA& frames_a, const std::vector<double>& times_a,
   std::vector<Vec6d> twists(K, Vec6d::Zero());
   // One pass suffices: mid-sweep poses are unbiased by the missing deskew (odometry.hpp).
   for (int pass = 0; pass < 1 && K >= 2; ++pass) {
-    Odometry<S> single(odo);
+    odometry::Odometry<S> single(odo);
     std::vector<Isometry3d> mids;
     std::vector<double> mid_times;
     for (std::size_t k = 0; k < K; ++k) {
       if (pass > 0) single.set_twist(twists[k]);
-      const auto scan = prepare_scan<S>(frames_a[pairs[k].a], twists[k], period_a, odo.scan);
-      const OdometryStep step = single.step(scan, t_a[k], nullptr, t_a[k]);
+      const auto scan =
+          odometry::prepare_scan<S>(frames_a[pairs[k].a], twists[k], period_a, odo.scan);
+      const odometry::OdometryStep step = single.step(scan, t_a[k], nullptr, t_a[k]);
       mids.push_back(step.mid_pose_a);
       mid_times.push_back(step.mid_time);
     }
-    twists = twists_from_mid_poses(mids, mid_times);
+    twists = odometry::twists_from_mid_poses(mids, mid_times);
   }
 
   Isometry3d C = initial;
@@ -179,21 +154,22 @@ JeepResult run_jeep(const FramesA& frames_a, const std::vector<double>& times_a,
   for (int round = 1; round <= options.max_rounds && !settled; ++round) {
     // Pose phase (eq:je_odom). After the first round the previous poses are close guesses:
     // the fine registration stage alone, and the calibration phase's fine stages alone.
-    OdometryOptions round_odo = odo;
+    odometry::OdometryOptions round_odo = odo;
     round_odo.single_stage = odo.single_stage || round > 1;
-    Odometry<S> odometry(round_odo, C);
-    std::vector<PreparedScan<S>> scans_a(K), scans_b(K);
+    odometry::Odometry<S> pose_phase(round_odo, C);
+    std::vector<odometry::PreparedScan<S>> scans_a(K), scans_b(K);
     std::vector<Isometry3d> mids(K), poses_a(K), poses_b(K), scan_poses_a(K), scan_poses_b(K);
     std::vector<double> mid_times(K);
     JeepRound trace;
     for (std::size_t k = 0; k < K; ++k) {
-      scans_a[k] = prepare_scan<S>(frames_a[pairs[k].a], twists[k], period_a, odo.scan);
-      scans_b[k] = prepare_scan<S>(frames_b[pairs[k].b], odometry.target_twist(twists[k]), period_b,
-                                   odo.scan);
-      odometry.set_twist(twists[k]);
+      scans_a[k] = odometry::prepare_scan<S>(frames_a[pairs[k].a], twists[k], period_a, odo.scan);
+      scans_b[k] = odometry::prepare_scan<S>(
+          frames_b[pairs[k].b], pose_phase.target_twist(twists[k]), period_b, odo.scan);
+      pose_phase.set_twist(twists[k]);
       std::optional<Isometry3d> guess;
       if (!previous_poses.empty()) guess = previous_poses[k];
-      const OdometryStep step = odometry.step(scans_a[k], t_a[k], &scans_b[k], t_b[k], guess);
+      const odometry::OdometryStep step =
+          pose_phase.step(scans_a[k], t_a[k], &scans_b[k], t_b[k], guess);
       if (k > 0 && !step.registered) ++trace.failed_steps;
       mids[k] = step.mid_pose_a;
       mid_times[k] = step.mid_time;
@@ -202,10 +178,10 @@ JeepResult run_jeep(const FramesA& frames_a, const std::vector<double>& times_a,
     }
     // Mid-sweep poses are unbiased by the deskew twists' errors; their central differences
     // give the next round's twists, and the poses at the timestamps.
-    twists = twists_from_mid_poses(mids, mid_times, twists[0]);
+    twists = odometry::twists_from_mid_poses(mids, mid_times, twists[0]);
     for (std::size_t k = 0; k < K; ++k) {
       poses_a[k] = mids[k] * ulc::se3_exp(Vec6d((t_a[k] - mid_times[k]) * twists[k]));
-      poses_b[k] = odometry.target_pose(poses_a[k], t_a[k], t_b[k], twists[k]);
+      poses_b[k] = pose_phase.target_pose(poses_a[k], t_a[k], t_b[k], twists[k]);
     }
 
     // Calibration phase (eq:calib_map): map b onto map a.
@@ -245,7 +221,8 @@ JeepResult run_jeep(const FramesA& frames_a, const std::vector<double>& times_a,
     result.poses_b.resize(K);
     for (std::size_t k = 0; k < K; ++k) {
       result.poses_a[k] = to_first * poses_a[k];
-      result.poses_b[k] = to_first_b * odometry.target_pose(poses_a[k], t_a[k], t_b[k], twists[k]);
+      result.poses_b[k] =
+          to_first_b * pose_phase.target_pose(poses_a[k], t_a[k], t_b[k], twists[k]);
     }
     result.twists = twists;
     result.calibration = calibration;
@@ -267,11 +244,6 @@ JeepResult run_jeep(const FramesA& frames_a, const std::vector<double>& times_a,
     }
     if (settled || round == options.max_rounds) {
       result.acceptance = assess(map_a, map_b, target, options.calibration, C, options.acceptance);
-      if (qualifies_for_second_look(result.acceptance, options.acceptance, options.second_look)) {
-        result.second_look = second_look(map_b, target, C, result.two_way, options.calibration,
-                                         options.start_search, options.second_look);
-        result.acceptance.accepted = result.second_look.passed;
-      }
       // In the output poses' frames (see to_first below).
       const Isometry3d to_first = poses_a[0].inverse();
       const Isometry3d to_first_b = C.inverse() * to_first * C;
@@ -287,9 +259,7 @@ JeepResult run_jeep(const FramesA& frames_a, const std::vector<double>& times_a,
   if (result.trace.back().failed_steps > 0)
     return fail(JeepStatus::registration_failed,
                 "a pose-phase step had too few correspondences in the last round");
-  if (!result.acceptance.accepted)
-    return fail(JeepStatus::rejected,
-                result.second_look.ran ? result.second_look.reason : result.acceptance.reason);
+  if (!result.acceptance.accepted) return fail(JeepStatus::rejected, result.acceptance.reason);
   return result;
 }
 

@@ -1,69 +1,26 @@
-// The options of JEEP and of its stages (scan preparation, local map, odometry, map
-// registration, start search, acceptance, second look, scan-to-scan) and the small functions
-// that build their defaults, apart from the algorithms: a user's file that only sets options
-// (ulc/calibrate/options.hpp, pair_calibration.hpp) includes this light header instead of the
-// stages' heavy ones (TBB, solvers, the stages' inline functions; docs/design.md). Each stage's
-// header includes it and documents the conventions the fields refer to: "the header comment"
-// or "the top" in a struct's comments below means its stage's header (AcceptanceOptions:
-// acceptance.hpp, SecondLookOptions: second_look.hpp).
+// The options of JEEP and of its stages (map registration, start search, acceptance,
+// scan-to-scan; the pose phase's odometry options are odometry/options.hpp's) and the small
+// functions that build their defaults, apart from the algorithms: a user's file that only sets
+// options includes this light header instead of the stages' heavy ones (TBB, solvers, the
+// stages' inline functions; docs/design.md). Each stage's header includes it and documents the
+// conventions the fields refer to: "the header comment" or "the top" in a struct's comments
+// below means its stage's header (AcceptanceOptions: acceptance.hpp).
 #pragma once
 
 #include <cstddef>
 #include <vector>
 
+#include "odometry/options.hpp"
 #include "ulc/core/registration_types.hpp"
 
 namespace jeep {
 
 using ulc::RegistrationOptions;
 
-struct ScanOptions {
-  double min_range = 2.0;           ///< m
-  double max_range = 100.0;         ///< m
-  double map_voxel = 0.5;           ///< m, resolution of the dense points
-  double registration_voxel = 1.0;  ///< m, resolution of the sparse points
-  bool deskew = true;
-};
-
-struct LocalMapOptions {
-  double voxel_size = 1.0;                ///< m
-  std::size_t max_points_per_voxel = 20;  ///< cap per voxel
-  double min_point_distance = 0.2;        ///< m, between points of one voxel
-  double max_distance = 100.0;            ///< m, voxels further from the sensor are dropped
-  double prune_step = 10.0;               ///< m of sensor travel between pruning checks
-  std::size_t normal_k = 8;               ///< neighbours of each plane fit
-  double min_planarity = 0.5;             ///< (l2 - l1) / l2 of a usable plane
-};
-
-struct OdometryOptions {
-  ScanOptions scan;
-  LocalMapOptions map;
-  /// m, gate of the first registration stage (the second uses half of it). With
-  /// single_stage, frames after the velocity is known get the second stage only.
-  double gate = 2.0;
-  double initial_gate = 3.0;   ///< m, first-stage gate while the velocity is unknown
-  double coarse_kernel = 0.2;  ///< m, Geman-McClure scale of the first stage
-  double fine_kernel = 0.05;   ///< m, of the second stage
-  /// Off by default: the fine stage alone (Geman-McClure 5 cm) ignores the right planes once
-  /// the constant-velocity prediction is a few decimetres off, e.g. when the vehicle brakes
-  /// or accelerates; the next prediction is then worse and the odometry runs away (60 s 64-32
-  /// drives, seeds 1-3: ATE 19-40 m with it, 0.17-0.37 m without, at the same speed;
-  /// docs/BENCHMARKS.md). JEEP's later rounds use it: they start from settled poses.
-  bool single_stage = false;
-  int max_iterations = 30;              ///< correspondence searches per stage
-  double translation_tolerance = 5e-4;  ///< m, second stage (the first: 1e-3)
-  double rotation_tolerance = 5e-5;     ///< rad, second stage (the first: 1e-4)
-  double target_weight = 1.0;           ///< weight of b's residuals against a's
-  double time_offset_s = 0.0;           ///< t_base_clock = t_target_clock + time_offset_s
-  double max_pair_gap = 0.5;            ///< in base frame periods
-  std::size_t min_correspondences = 30;
-  double min_condition = 1e-3;  ///< registration_conditioning.hpp
-};
-
 /// The pose phase inside JEEP: denser scans (the calibration phase maps them), both stages
 /// always, tighter tolerances; a handful of frames, so speed matters less than in odometry.
-inline OdometryOptions jeep_pose_phase_options() {
-  OdometryOptions o;
+inline odometry::OdometryOptions jeep_pose_phase_options() {
+  odometry::OdometryOptions o;
   o.scan.map_voxel = 0.4;
   o.scan.registration_voxel = 0.75;
   o.map.min_point_distance = 0.3;
@@ -115,8 +72,8 @@ struct AcceptanceOptions {
 };
 
 struct ScanScanOptions {
-  ScanOptions scan = [] {
-    ScanOptions o;
+  odometry::ScanOptions scan = [] {
+    odometry::ScanOptions o;
     o.map_voxel = 0.25;
     o.deskew = false;
     return o;
@@ -137,20 +94,10 @@ struct StartSearchOptions {
   double reach_translation = 5.0;                                 ///< m
 };
 
-struct SecondLookOptions {
-  bool enabled = false;                  ///< opt-in: see "Measured" at the top
-  double min_off_ground_overlap = 0.10;  ///< below: no second look
-  double max_gap_translation = 0.02;     ///< m
-  double max_gap_rotation = 0.1 * 3.14159265358979323846 / 180.0;  ///< rad
-  std::size_t min_returned = 10;                                   ///< of the twelve starts
-  double return_translation = 0.01;                                ///< m
-  double return_rotation = 0.05 * 3.14159265358979323846 / 180.0;  ///< rad
-};
-
 struct JeepOptions {
   std::size_t frames = 5;  ///< K, frame pairs used
   int max_rounds = 10;     ///< more rounds without settling is a failure
-  OdometryOptions odometry = jeep_pose_phase_options();
+  odometry::OdometryOptions odometry = jeep_pose_phase_options();
   MapRegistrationOptions calibration = default_map_registration();
   /// The first calibration phase also starts from turned and shifted copies of the initial
   /// extrinsic and keeps the best basin (start_search.hpp).
@@ -162,8 +109,6 @@ struct JeepOptions {
   double settle_translation = 0.005;  ///< m
   double settle_rotation = 3.5e-4;    ///< rad (0.02 deg)
   AcceptanceOptions acceptance;
-  /// Opt-in: a refusal for the off-ground overlap alone gets a second look (second_look.hpp).
-  SecondLookOptions second_look;
   /// Frame period when the timestamps cannot tell (a single frame): docs/design.md's 10 Hz.
   double default_period = 0.1;
   /// Once settled, meet map a registered to map b's planes halfway (two_way.hpp), so that

@@ -13,7 +13,7 @@
 #include "jeep/acceptance.hpp"
 #include "jeep/map_registration.hpp"
 #include "jeep/options.hpp"
-#include "jeep/scan_preparation.hpp"
+#include "odometry/scan_preparation.hpp"
 #include "ulc/core/point_traits.hpp"
 #include "ulc/core/types.hpp"
 
@@ -50,15 +50,15 @@ ScanScanResult scan_to_scan(const CloudA& scan_a, const CloudB& scan_b, const Is
   using S = ulc::traits::scalar_t<CloudA>;
   ScanScanResult result;
   result.extrinsic = initial;
-  if (!initial.matrix().allFinite() || !valid_scan_options(options.scan) ||
+  if (!initial.matrix().allFinite() || !odometry::valid_scan_options(options.scan) ||
       options.registration.stages.empty()) {
     result.status = ScanScanStatus::invalid_input;
     result.reason = "bad options or initial extrinsic";
     return result;
   }
   const ulc::Vec6d still = ulc::Vec6d::Zero();
-  const auto a = prepare_scan<S>(scan_a, still, 0.0, options.scan);
-  const auto b = prepare_scan<S>(scan_b, still, 0.0, options.scan);
+  const auto a = odometry::prepare_scan<S>(scan_a, still, 0.0, options.scan);
+  const auto b = odometry::prepare_scan<S>(scan_b, still, 0.0, options.scan);
   const auto target = map_target(a.dense, options.registration);
   result.registration = register_maps(b.dense, target, initial, options.registration);
   const auto status = result.registration.status;

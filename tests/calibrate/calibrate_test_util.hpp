@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "../support/test_units.hpp"
-#include "ulc/calibrate.hpp"
+#include "pipeline/calibrate.hpp"
 #include "ulc/core/lie.hpp"
 #include "ulc/core/point_cloud.hpp"
 #include "ulc/core/types.hpp"

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "calibrate_test_util.hpp"
-#include "ulc/calibrate.hpp"
+#include "pipeline/calibrate.hpp"
 #include "ulc/core/pose_error.hpp"
 #include "ulc/io/result_entry.hpp"
 #include "ulc/io/result_file.hpp"
@@ -52,11 +52,11 @@ TEST_CASE("terra,jeep recovers the 64-32 mounting with no initial guess", "[cali
   // TERRA's rotation is a rotation initialisation, and JEEP started from it with zero translation.
   REQUIRE(r.terra);
   REQUIRE(r.jeep);
-  CHECK(r.terra->status == "ok");
+  CHECK(r.terra->status == terra::SearchStatus::ok);
   CHECK(ulc::rotation_error_rad(truth().linear(), r.terra->rotation) < 10 * kDeg);
   CHECK(r.jeep->initial.linear() == r.terra->rotation);
   CHECK(r.jeep->initial.translation() == ulc::Vec3d::Zero());
-  CHECK(r.jeep->status == "ok");
+  CHECK(r.jeep->status == jeep::JeepStatus::ok);
   CHECK(r.jeep->rounds >= 2);
   CHECK(r.jeep->frame_pairs == 5);
   CHECK(r.terra->stats.coarse.rotations > 0);
@@ -168,19 +168,19 @@ TEST_CASE("refusals come back as a status and a reason", "[calibrate][status]") 
   const auto terra_failed = ulc::calibrate_pair(fa, ta, near, std::vector<double>{ta[0]}, o);
   expect(terra_failed, CalibrateStatus::terra_failed, "TERRA: no_overlap");
   REQUIRE(terra_failed.terra);
-  CHECK(terra_failed.terra->status == "no_overlap");
+  CHECK(terra_failed.terra->status == terra::SearchStatus::no_overlap);
   CHECK(!terra_failed.jeep);  // no stage runs after a failed one
   CHECK(same_bits(terra_failed.T_base_target, ulc::Isometry3d::Identity()));
 
   // JEEP that cannot settle in one round: the result keeps JEEP's input, and says why.
   o.stages = {Stage::jeep};
   o.initial = disturbed(truth(), 3, 2.0 * kDeg, 0.3);
-  o.jeep.max_rounds = 1;
-  o.jeep.frames = 2;
+  o.tuning.jeep.max_rounds = 1;
+  o.tuning.jeep.frames = 2;
   const auto jeep_failed = ulc::calibrate_pair(fa, ta, fb, tb, o);
   expect(jeep_failed, CalibrateStatus::jeep_failed, "JEEP: not_converged");
   REQUIRE(jeep_failed.jeep);
-  CHECK(jeep_failed.jeep->status == "not_converged");
+  CHECK(jeep_failed.jeep->status == jeep::JeepStatus::not_converged);
   CHECK(jeep_failed.jeep->rounds == 1);
   CHECK(same_bits(jeep_failed.T_base_target, *o.initial));
 }
@@ -188,7 +188,7 @@ TEST_CASE("refusals come back as a status and a reason", "[calibrate][status]") 
 TEST_CASE("calibrate_pair gives the same bits on 1 and 2 threads", "[calibrate][threads]") {
   ulc::CalibrateOptions o;
   o.stages = {Stage::terra, Stage::jeep};
-  o.jeep.frames = 3;
+  o.tuning.jeep.frames = 3;
   o.frame_index = 1;
   auto run = [&] {
     return ulc::calibrate_pair(base().frames, base().timestamps, target().frames,

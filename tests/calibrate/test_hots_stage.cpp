@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "calibrate_test_util.hpp"
-#include "ulc/calibrate.hpp"
+#include "pipeline/calibrate.hpp"
 #include "ulc/core/pose_error.hpp"
 #include "ulc/io/result_entry.hpp"
 #include "ulc/io/result_file.hpp"
@@ -32,7 +32,7 @@ TEST_CASE("on a 3 s drive HOTS says the clock offset cannot be trusted", "[calib
              Catch::Contains("time_offset_untrusted") && Catch::Contains("--synced-clocks"));
   REQUIRE(c.jeep);
   REQUIRE(c.hots);
-  CHECK(c.hots->status == "time_offset_untrusted");
+  CHECK(c.hots->status == hots::RefineStatus::time_offset_untrusted);
   CHECK(c.hots->statistics.sequence.time_offset_checked);
   CHECK_FALSE(c.hots->statistics.sequence.time_offset_trusted);
   CHECK(same_bits(c.T_base_target, c.jeep->extrinsic));  // a failed HOTS keeps JEEP's answer
@@ -67,7 +67,8 @@ TEST_CASE("terra,jeep,hots recovers the 64-32 mounting with synchronised clocks"
 
   // HOTS started from JEEP's extrinsic, over every frame, and its outputs are the result's.
   const auto& h = *c.hots;
-  CHECK(h.status == "ok");
+  CHECK(h.run == ulc::HotsRun::refined);
+  CHECK(h.status == hots::RefineStatus::ok);
   CHECK(same_bits(h.initial, c.jeep->extrinsic));
   CHECK(same_bits(h.extrinsic, c.T_base_target));
   CHECK(h.frames_base == a.frames.size());
@@ -142,7 +143,7 @@ TEST_CASE("a failing odometry or HOTS gives hots_failed and keeps the extrinsic 
   o.stages = {Stage::hots};
   o.initial = disturbed(d.pairs[0].T_base_target, 5, 0.5 * kDeg, 0.05);
 
-  o.odometry.max_pair_gap = -1.0;  // refused by the odometry before any work
+  o.tuning.odometry.max_pair_gap = -1.0;  // refused by the odometry before any work
   const auto odometry_failed =
       ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, o);
   INFO(odometry_failed.reason);
@@ -150,20 +151,20 @@ TEST_CASE("a failing odometry or HOTS gives hots_failed and keeps the extrinsic 
   CHECK_FALSE(odometry_failed.success);
   CHECK_THAT(odometry_failed.reason, Catch::Contains("HOTS: odometry: invalid_input"));
   REQUIRE(odometry_failed.hots);
-  CHECK(odometry_failed.hots->status == "not_run");
+  CHECK(odometry_failed.hots->run == ulc::HotsRun::odometry_failed);
   CHECK(same_bits(odometry_failed.T_base_target, *o.initial));
   CHECK(!odometry_failed.covariance_6x6);
 
-  o.odometry = {};
-  o.hots.passes = 0;  // refused by hots::refine after the odometry ran
+  o.tuning.odometry = {};
+  o.tuning.hots.passes = 0;  // refused by hots::refine after the odometry ran
   const auto hots_failed = ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, o);
   INFO(hots_failed.reason);
   CHECK(hots_failed.status == CalibrateStatus::hots_failed);
   CHECK_FALSE(hots_failed.success);
   CHECK_THAT(hots_failed.reason, Catch::Contains("HOTS: invalid_input"));
   REQUIRE(hots_failed.hots);
-  CHECK(hots_failed.hots->odometry_status == "ok");
-  CHECK(hots_failed.hots->status == "invalid_input");
+  CHECK(hots_failed.hots->odometry_status == odometry::OdometryStatus::ok);
+  CHECK(hots_failed.hots->status == hots::RefineStatus::invalid_input);
   CHECK(same_bits(hots_failed.T_base_target, *o.initial));
   CHECK(hots_failed.time_offset_s == 0.0);
   const auto entry = ulc::io::to_pair_result(hots_failed, "lidar64", "lidar32");

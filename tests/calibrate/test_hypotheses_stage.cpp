@@ -1,5 +1,5 @@
-// HOTS as the pipeline's judge (ulc/calibrate.hpp): TERRA's next hypotheses run when the stages
-// after its best rotation fail in a way that points at the rotation, and a JEEP that did not
+// HOTS as the pipeline's judge (pipeline/calibrate.hpp): TERRA's next hypotheses run when the
+// stages after its best rotation fail in a way that points at the rotation, and a JEEP that did not
 // settle hands its extrinsic to HOTS instead of ending the call.
 #include <algorithm>
 #include <catch2/catch.hpp>
@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "calibrate_test_util.hpp"
-#include "ulc/calibrate.hpp"
+#include "pipeline/calibrate.hpp"
 #include "ulc/core/pose_error.hpp"
 #include "ulc/io/result_entry.hpp"
 
@@ -24,8 +24,8 @@ TEST_CASE("when HOTS refuses every start, TERRA's next hypotheses are tried and 
   ulc::CalibrateOptions o;
   o.time_offset_s = 0.0;
   // A judge nothing can satisfy: every start ends extrinsic_unconfirmed.
-  o.hots.min_cross_links = std::numeric_limits<std::size_t>::max();
-  o.terra_fallback_hypotheses = 2;  // two of the fallback's, to keep the test short
+  o.tuning.hots.min_cross_links = std::numeric_limits<std::size_t>::max();
+  o.tuning.hypotheses.fallback = 2;  // two of the fallback's, to keep the test short
   std::vector<std::string> stages_seen;
   o.progress = record_stages(stages_seen);
   const auto c = ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, o);
@@ -34,23 +34,24 @@ TEST_CASE("when HOTS refuses every start, TERRA's next hypotheses are tried and 
   REQUIRE(c.terra);
   const auto& tried = c.terra->hypotheses;
   REQUIRE(tried.size() >= 2);
-  CHECK(tried.size() <= o.terra_hypotheses + o.terra_fallback_hypotheses);
+  CHECK(tried.size() <= o.tuning.hypotheses.count + o.tuning.hypotheses.fallback);
   // Best first (TERRA's own answer), the search's optima by distance, then the fallback's;
   // distinct basins throughout.
   CHECK(tried[0].rotation.isApprox(c.terra->rotation));
-  const std::size_t primary = std::min(tried.size(), o.terra_hypotheses);
+  const std::size_t primary = std::min(tried.size(), o.tuning.hypotheses.count);
   for (std::size_t k = 0; k < tried.size(); ++k) {
-    INFO("hypothesis " << k << " (" << tried[k].source << "): " << tried[k].outcome);
-    CHECK((tried[k].outcome.find("extrinsic_unconfirmed") != std::string::npos ||
-           tried[k].outcome.find("jeep_failed") != std::string::npos));
+    INFO("hypothesis " << k << " (" << ulc::to_string(tried[k].source)
+                       << "): " << ulc::to_string(tried[k].status) << ": " << tried[k].reason);
+    CHECK((tried[k].status == ulc::CalibrateStatus::jeep_failed ||
+           tried[k].reason.find("extrinsic_unconfirmed") != std::string::npos));
     if (k < primary) CHECK(tried[k].source == c.terra->source);
     // The fallback's need JEEP's own acceptance: a refused JEEP is not handed to HOTS.
-    if (k >= primary && tried[k].outcome.find("jeep_failed") != std::string::npos)
-      CHECK_THAT(tried[k].outcome, !Catch::Contains("HOTS, run from its extrinsic"));
+    if (k >= primary && tried[k].status == ulc::CalibrateStatus::jeep_failed)
+      CHECK_THAT(tried[k].reason, !Catch::Contains("HOTS, run from its extrinsic"));
     if (k > 0 && k < primary) CHECK(tried[k - 1].distance <= tried[k].distance);
     for (std::size_t m = 0; m < k; ++m)
       CHECK(ulc::rotation_error_rad(tried[m].rotation, tried[k].rotation) >=
-            o.terra_hypothesis_separation_deg * kDeg);
+            o.tuning.hypotheses.separation_deg * kDeg);
   }
   // The result is the best hypothesis's failure, its JEEP started from TERRA's best.
   CHECK(c.terra->hypothesis_used == 0);
@@ -62,12 +63,12 @@ TEST_CASE("when HOTS refuses every start, TERRA's next hypotheses are tried and 
   const auto entry = ulc::io::to_pair_result(c, "lidar64", "lidar32");
   CHECK(entry.stages.at("terra").at("hypotheses").size() == tried.size());
   CHECK(entry.stages.at("terra").at("hypotheses")[std::size_t{0}].at("source").get<std::string>() ==
-        c.terra->source);
+        ulc::to_string(c.terra->source));
   CHECK(entry.stages.at("terra").at("hypothesis_used").get<double>() == 0.0);
 
   // One hypothesis and no fallback: the paper's single answer, and nothing else is tried.
-  o.terra_hypotheses = 1;
-  o.terra_fallback_hypotheses = 0;
+  o.tuning.hypotheses.count = 1;
+  o.tuning.hypotheses.fallback = 0;
   const auto single = ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, o);
   REQUIRE(single.terra);
   CHECK(single.terra->hypotheses.size() == 1);
@@ -85,11 +86,11 @@ TEST_CASE("a JEEP that did not settle is judged by HOTS, which confirms and refi
   o.stages = {Stage::jeep, Stage::hots};
   o.initial = disturbed(truth, 3, 2.0 * kDeg, 0.3);
   o.time_offset_s = 0.0;
-  o.jeep.max_rounds = 1;  // JEEP cannot settle in one round
+  o.tuning.jeep.max_rounds = 1;  // JEEP cannot settle in one round
   const auto c = ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, o);
   INFO(ulc::to_string(c.status) << ": " << c.reason);
   REQUIRE(c.jeep);
-  CHECK(c.jeep->status == "not_converged");
+  CHECK(c.jeep->status == jeep::JeepStatus::not_converged);
   CHECK(c.jeep->judged_by_hots);
   REQUIRE(c.success);
   REQUIRE(c.hots);
@@ -106,7 +107,7 @@ TEST_CASE("a JEEP that did not settle is judged by HOTS, which confirms and refi
             .get<bool>());
 
   // JEEP's verdict stands when asked to: the call ends with JEEP's failure and its input.
-  o.hots_judges_jeep = false;
+  o.tuning.hypotheses.hots_judges_jeep = false;
   const auto vetoed = ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, o);
   CHECK(vetoed.status == CalibrateStatus::jeep_failed);
   REQUIRE(vetoed.jeep);
@@ -132,7 +133,7 @@ TEST_CASE("the fallback finds the 90-deg-pitched VLP-16 where the map search's o
   const auto c = ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, o);
   INFO(ulc::to_string(c.status) << ": " << c.reason);
   REQUIRE(c.terra);
-  CHECK(c.terra->source == "maps");
+  CHECK(c.terra->source == ulc::TerraSource::maps);
   REQUIRE(c.success);
   const auto e = ulc::pose_error(truth, c.T_base_target);
   INFO("e_rot " << e.rotation_deg << " deg, e_trans " << e.translation_m << " m");
@@ -141,10 +142,12 @@ TEST_CASE("the fallback finds the 90-deg-pitched VLP-16 where the map search's o
   // The answer came from the fallback, and every hypothesis before it failed.
   const auto& tried = c.terra->hypotheses;
   REQUIRE(c.terra->hypothesis_used < tried.size());
-  CHECK(c.terra->hypothesis_used >= o.terra_hypotheses);
-  CHECK(tried[c.terra->hypothesis_used].outcome == "ok");
-  CHECK(tried[c.terra->hypothesis_used].source == "frames");
-  for (std::size_t k = 0; k < c.terra->hypothesis_used; ++k) CHECK(tried[k].outcome != "ok");
+  CHECK(c.terra->hypothesis_used >= o.tuning.hypotheses.count);
+  CHECK(tried[c.terra->hypothesis_used].status == ulc::CalibrateStatus::ok);
+  CHECK(tried[c.terra->hypothesis_used].source == ulc::TerraSource::frames);
+  for (std::size_t k = 0; k < c.terra->hypothesis_used; ++k)
+    CHECK(tried[k].status != ulc::CalibrateStatus::ok);
   REQUIRE(c.jeep);
-  CHECK(c.jeep->status == "ok");  // a fallback hypothesis needs JEEP's own acceptance
+  CHECK(c.jeep->status ==
+        jeep::JeepStatus::ok);  // a fallback hypothesis needs JEEP's own acceptance
 }

@@ -1,6 +1,6 @@
-// TERRA on local maps (ulc/calibrate/map_terra.hpp) and calibrate_pair's choice between frames
-// and maps (CalibrateOptions::terra_source), on a short simulated 64-tele drive: an HDL-64E
-// base and a Livox Tele-15 target whose single frame fills ~50 lattice cells.
+// TERRA on local maps (pipeline/map_terra.hpp) and calibrate_pair's choice between frames
+// and maps (CalibrateOptions::tuning.terra_source.source), on a short simulated 64-tele drive: an
+// HDL-64E base and a Livox Tele-15 target whose single frame fills ~50 lattice cells.
 #include <tbb/task_arena.h>
 #include <catch2/catch.hpp>
 #include <cstring>
@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "calibrate_test_util.hpp"
-#include "ulc/calibrate.hpp"
-#include "ulc/calibrate/map_terra.hpp"
+#include "pipeline/calibrate.hpp"
+#include "pipeline/map_terra.hpp"
 #include "ulc/core/pose_error.hpp"
 #include "ulc/io/result_entry.hpp"
 #include "ulc/sim/sim.hpp"
@@ -44,8 +44,8 @@ double error_deg(const ulc::Mat3d& truth, const ulc::Mat3d& R) {
 ulc::CalibrateOptions terra_only(ulc::TerraSource source) {
   ulc::CalibrateOptions o;
   o.stages = {ulc::Stage::terra};
-  o.terra_source = source;
-  o.terra_maps.window_s = 3.0;
+  o.tuning.terra_source.source = source;
+  o.tuning.terra_source.maps.window_s = 3.0;
   return o;
 }
 
@@ -77,7 +77,7 @@ TEST_CASE("TERRA on 3 s local maps finds the 64-tele rotation that single frames
   // matches of 2-5 cells win eq:feature_dis (measured: ~145 deg off).
   const auto frames = run(ulc::TerraSource::frames);
   REQUIRE(frames.terra);
-  CHECK(frames.terra->source == "frames");
+  CHECK(frames.terra->source == ulc::TerraSource::frames);
   CHECK(!frames.terra->base_map);
   CHECK(*frames.terra->frames_mask_count < 30);
   CHECK((!frames.success || error_deg(truth, frames.terra->rotation) > 10.0));
@@ -86,15 +86,15 @@ TEST_CASE("TERRA on 3 s local maps finds the 64-tele rotation that single frames
   const auto maps = run(ulc::TerraSource::maps);
   REQUIRE(maps.success);
   REQUIRE(maps.terra);
-  CHECK(maps.terra->source == "maps");
+  CHECK(maps.terra->source == ulc::TerraSource::maps);
   CHECK(error_deg(truth, maps.terra->rotation) < 5.0);
   CHECK(maps.terra->mask_count > 5 * *frames.terra->frames_mask_count);
   REQUIRE(maps.terra->base_map);
   REQUIRE(maps.terra->target_map);
   CHECK(maps.terra->base_map->frames == 31);  // 3 s at 10 Hz, both ends
   CHECK(maps.terra->target_map->frames == 31);
-  CHECK(maps.terra->base_map->odometry_status == "ok");
-  CHECK(maps.terra->target_map->odometry_status == "ok");
+  CHECK(maps.terra->base_map->odometry_status == odometry::OdometryStatus::ok);
+  CHECK(maps.terra->target_map->odometry_status == odometry::OdometryStatus::ok);
   CHECK(maps.terra->target_map->points > 0);
   CHECK(maps.terra->target_map->points <= ulc::MapTerraOptions().max_points);
   CHECK(maps.terra->base_points == maps.terra->base_map->points);
@@ -103,7 +103,7 @@ TEST_CASE("TERRA on 3 s local maps finds the 64-tele rotation that single frames
   // automatic: the frames overlap too little, so it tries the maps and keeps them; same answer.
   const auto automatic = run(ulc::TerraSource::automatic);
   REQUIRE(automatic.success);
-  CHECK(automatic.terra->source == "maps");
+  CHECK(automatic.terra->source == ulc::TerraSource::maps);
   CHECK(same_bits(automatic.terra->rotation, maps.terra->rotation));
   CHECK(*automatic.terra->frames_mask_count == *frames.terra->frames_mask_count);
 
@@ -127,7 +127,7 @@ TEST_CASE("automatic TERRA stays on frames for single frames and for well-overla
     const auto c =
         ulc::calibrate_pair(fa, {0.0}, fb, {0.0}, terra_only(ulc::TerraSource::automatic));
     REQUIRE(c.terra);
-    CHECK(c.terra->source == "frames");
+    CHECK(c.terra->source == ulc::TerraSource::frames);
     CHECK(!c.terra->base_map);
     CHECK(c.terra->source_reason.find("1 frame") != std::string::npos);
   }
@@ -136,11 +136,12 @@ TEST_CASE("automatic TERRA stays on frames for single frames and for well-overla
     const auto& a = *d.find("lidar64");
     const auto& b = *d.find("lidar32");
     ulc::CalibrateOptions o = terra_only(ulc::TerraSource::automatic);
-    o.terra_maps_min_frames = 2;  // the 0.6 s drive has 6 frames: maps would be possible
+    o.tuning.terra_source.maps_min_frames =
+        2;  // the 0.6 s drive has 6 frames: maps would be possible
     const auto c = ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, o);
     REQUIRE(c.success);
-    CHECK(c.terra->source == "frames");
-    CHECK(*c.terra->frames_mask_count >= o.terra_maps_below_mask);
+    CHECK(c.terra->source == ulc::TerraSource::frames);
+    CHECK(*c.terra->frames_mask_count >= o.tuning.terra_source.maps_below_mask);
     CHECK(!c.terra->base_map);
     CHECK(error_deg(d.pairs.at(0).T_base_target.linear(), c.T_base_target.linear()) < 5.0);
   }

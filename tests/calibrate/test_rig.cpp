@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "calibrate_test_util.hpp"
-#include "ulc/calibrate/rig.hpp"
+#include "pipeline/rig.hpp"
 #include "ulc/core/pose_error.hpp"
 
 using namespace calibrate_test;

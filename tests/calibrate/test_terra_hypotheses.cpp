@@ -1,4 +1,4 @@
-// TERRA's hypotheses (ulc/calibrate/terra_hypotheses.hpp): the search's optima, best first,
+// TERRA's hypotheses (pipeline/terra_hypotheses.hpp): the search's optima, best first,
 // one per basin, and the first always the search's own answer.
 #include <catch2/catch.hpp>
 
@@ -6,7 +6,7 @@
 #include <cmath>
 
 #include "../support/test_units.hpp"
-#include "ulc/calibrate/terra_hypotheses.hpp"
+#include "pipeline/terra_hypotheses.hpp"
 
 namespace {
 

@@ -53,7 +53,8 @@ TEST_CASE("refine improves a disturbed extrinsic on a simulated 64-32 drive", "[
   const auto [C_gt, C0, pa, pb] = disturbed_start();
   hots::RefineOptions options;
   const hots::RefineResult r =
-      hots::refine(a.frames, a.timestamps, pa, b.frames, b.timestamps, pb, C0, options);
+      hots::refine(ulc::make_sequence(a.frames, a.timestamps, pa),
+                   ulc::make_sequence(b.frames, b.timestamps, pb), C0, options);
   INFO(hots::to_string(r.status) << ": " << r.reason);
   // 3 s of driving does not pin a clock offset down: HOTS says so, and still returns what it
   // refined (the offset it kept, the extrinsic, the poses).
@@ -100,7 +101,8 @@ TEST_CASE("refine with rigid frames or continuous-time sweeps in the layer-0 BA"
   hots::RefineResult r;
   for (const int parts : {1, 2}) {
     options.hierarchy.sweep_parts = parts;
-    r = hots::refine(a.frames, a.timestamps, pa, b.frames, b.timestamps, pb, C0, options);
+    r = hots::refine(ulc::make_sequence(a.frames, a.timestamps, pa),
+                     ulc::make_sequence(b.frames, b.timestamps, pb), C0, options);
     INFO("parts " << parts << ": " << hots::to_string(r.status) << ": " << r.reason);
     REQUIRE(r.ok());
     const auto e0 = ulc::pose_error(C_gt, C0);
@@ -118,7 +120,8 @@ TEST_CASE("refine with rigid frames or continuous-time sweeps in the layer-0 BA"
   // With end_knot_factor, every layer-0 window but each LiDAR's last adds its end knot's factor.
   options.hierarchy.end_knot_factor = true;
   const hots::RefineResult rf =
-      hots::refine(a.frames, a.timestamps, pa, b.frames, b.timestamps, pb, C0, options);
+      hots::refine(ulc::make_sequence(a.frames, a.timestamps, pa),
+                   ulc::make_sequence(b.frames, b.timestamps, pb), C0, options);
   REQUIRE(rf.ok());
   const std::size_t windows_a = (a.frames.size() + 4) / 5, windows_b = (b.frames.size() + 4) / 5;
   CHECK(rf.statistics.ba_factors == r.statistics.ba_factors + windows_a - 1 + windows_b - 1);
@@ -138,8 +141,8 @@ hots::RefineResult one_layer(const std::vector<ulc::Isometry3d>& pa,
   options.synchronise_time = false;  // the clocks agree; 3 s could not show it anyway
   options.boundary_registration = registration;
   options.boundary_sigma_m = odometry_sigma_m;
-  return hots::refine(d.data.lidars[0].frames, d.data.lidars[0].timestamps, pa,
-                      d.data.lidars[1].frames, d.data.lidars[1].timestamps, pb,
+  return hots::refine(ulc::make_sequence(d.data.lidars[0].frames, d.data.lidars[0].timestamps, pa),
+                      ulc::make_sequence(d.data.lidars[1].frames, d.data.lidars[1].timestamps, pb),
                       d.data.pairs[0].T_base_target, options);
 }
 
@@ -172,7 +175,8 @@ TEST_CASE("an extrinsic the LiDARs' views do not confirm is refused", "[hots][re
   const auto pb = drifting(d.truth_b, b.timestamps, 2);
   hots::RefineOptions options;
   const hots::RefineResult r =
-      hots::refine(a.frames, a.timestamps, pa, b.frames, b.timestamps, pb, wrong, options);
+      hots::refine(ulc::make_sequence(a.frames, a.timestamps, pa),
+                   ulc::make_sequence(b.frames, b.timestamps, pb), wrong, options);
   const auto& st = r.statistics;
   INFO(hots::to_string(r.status) << ": " << r.reason << "; links " << st.cross_links << "/"
                                  << st.cross_links_attempted);
@@ -186,7 +190,8 @@ TEST_CASE("an extrinsic the LiDARs' views do not confirm is refused", "[hots][re
   // The rule is the statistics' own verdict: off, the same run reaches the next check.
   options.min_cross_link_ratio = 0.0;
   const hots::RefineResult unchecked =
-      hots::refine(a.frames, a.timestamps, pa, b.frames, b.timestamps, pb, wrong, options);
+      hots::refine(ulc::make_sequence(a.frames, a.timestamps, pa),
+                   ulc::make_sequence(b.frames, b.timestamps, pb), wrong, options);
   CHECK(unchecked.status != hots::RefineStatus::extrinsic_unconfirmed);
   // ... and the graph, with no link to hold the extrinsic, misses the rig bar (0.1 deg, 2 cm)
   // by far. (The whole-sequence step after it may still find the truth from there: on this
@@ -324,33 +329,8 @@ TEST_CASE("refine reports unusable input", "[hots][refine]") {
   const auto& a = d.data.lidars[0];
   const auto& b = d.data.lidars[1];
   std::vector<ulc::Isometry3d> short_poses(d.truth_a.begin(), d.truth_a.begin() + 3);
-  CHECK(hots::refine(a.frames, a.timestamps, short_poses, b.frames, b.timestamps, d.truth_b,
+  CHECK(hots::refine(ulc::make_sequence(a.frames, a.timestamps, short_poses),
+                     ulc::make_sequence(b.frames, b.timestamps, d.truth_b),
                      ulc::Isometry3d::Identity())
             .status == hots::RefineStatus::invalid_input);
-}
-
-TEST_CASE("b's sweep taken from the base's trajectory through the extrinsic", "[hots][deskew]") {
-  // The base moves with a constant body twist; b's sweep over [t, t + D] is then
-  // C^-1 exp(D xi) C, and it does not depend on where along the trajectory it starts.
-  const ulc::Vec6d xi = (ulc::Vec6d() << 8.0, 0.3, 0.0, 0.0, 0.02, 0.35).finished();
-  std::vector<double> times_a;
-  std::vector<ulc::Isometry3d> world_a;
-  for (int k = 0; k < 20; ++k) {
-    times_a.push_back(0.1 * k);
-    world_a.push_back(ulc::se3_exp(ulc::Vec6d(times_a.back() * xi)));
-  }
-  std::mt19937_64 rng(3);
-  const ulc::Isometry3d C =
-      jeep_test::disturbed(ulc::Isometry3d::Identity(), rng, 40.0 * hots_test::kDeg, 1.5);
-  const std::vector<double> times_b{0.02, 0.12, 0.22, 0.32};
-  const double dt = 0.037;
-  for (std::size_t k = 0; k < times_b.size(); ++k) {
-    const auto sweep = hots::hots_detail::base_sweep(times_b, times_a, world_a, C, dt, k);
-    CHECK(sweep.second == Approx(0.1));
-    const ulc::Isometry3d expected = C.inverse() * ulc::se3_exp(ulc::Vec6d(0.1 * xi)) * C;
-    // Linear interpolation between 10 Hz poses: exact for the rotation, a bending of the
-    // translation by at most the arc's sagitta |v| |w| T^2 / 8 at each end (here 3.5 mm).
-    CHECK((sweep.first.translation() - expected.translation()).norm() < 7e-3);
-    CHECK(ulc::so3_log(sweep.first.linear() * expected.linear().transpose()).norm() < 1e-9);
-  }
 }

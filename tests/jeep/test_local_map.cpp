@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "../registration/registration_test_util.hpp"
-#include "jeep/local_map.hpp"
+#include "odometry/local_map.hpp"
 
 using namespace reg_test;
 
@@ -23,7 +23,7 @@ std::vector<ulc::Vec3<float>> as_float(const std::vector<Vec3d>& p) {
 
 TEST_CASE("local map: find_plane returns the nearest point with a plane, as brute force does",
           "[jeep][map]") {
-  jeep::LocalMap<float> map;
+  odometry::LocalMap<float> map;
   map.insert(as_float(courtyard(1, 4000, 0.01)), Vec3d::Zero());
   const auto points = map.points();
   const auto normals = map.normals();
@@ -56,11 +56,11 @@ TEST_CASE("local map: find_plane returns the nearest point with a plane, as brut
 
 TEST_CASE("local map: capped voxels, spaced points, and a parked sensor adds nothing",
           "[jeep][map]") {
-  jeep::LocalMapOptions o;
+  odometry::LocalMapOptions o;
   o.voxel_size = 1.0;
   o.max_points_per_voxel = 12;
   o.min_point_distance = 0.15;
-  jeep::LocalMap<double> map(o);
+  odometry::LocalMap<double> map(o);
   std::vector<Vec3d> scan = courtyard(3, 20000, 0.01);
   map.insert(scan, Vec3d::Zero());
   const std::size_t first = map.size();
@@ -84,7 +84,7 @@ TEST_CASE("local map: capped voxels, spaced points, and a parked sensor adds not
 }
 
 TEST_CASE("local map: planes follow the surfaces", "[jeep][map]") {
-  jeep::LocalMap<double> map;
+  odometry::LocalMap<double> map;
   map.insert(courtyard(5, 6000, 0.005), Vec3d::Zero());
   const auto pts = map.points();
   const auto nrm = map.normals();
@@ -102,10 +102,10 @@ TEST_CASE("local map: planes follow the surfaces", "[jeep][map]") {
 }
 
 TEST_CASE("local map: voxels beyond max_distance from the sensor are dropped", "[jeep][map]") {
-  jeep::LocalMapOptions o;
+  odometry::LocalMapOptions o;
   o.max_distance = 40.0;
   o.prune_step = 5.0;
-  jeep::LocalMap<float> map(o);
+  odometry::LocalMap<float> map(o);
   map.insert(as_float(courtyard(1, 2000, 0.01)), Vec3d::Zero());
   const std::size_t here = map.size();
   // Drive 100 m east and see the same kind of courtyard there.
@@ -122,7 +122,7 @@ TEST_CASE("local map: voxels beyond max_distance from the sensor are dropped", "
 
 TEST_CASE("local map: the same map for 1 and 2 threads", "[jeep][map][threads]") {
   auto build = [] {
-    jeep::LocalMap<float> map;
+    odometry::LocalMap<float> map;
     map.insert(as_float(courtyard(1, 5000, 0.01)), Vec3d::Zero());
     map.insert(as_float(courtyard(2, 5000, 0.01)), Vec3d::Zero());
     return std::make_pair(map.points(), map.normals());

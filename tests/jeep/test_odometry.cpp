@@ -5,8 +5,8 @@
 #include <cstring>
 #include <vector>
 
-#include "jeep/run_odometry.hpp"
 #include "jeep_test_util.hpp"
+#include "odometry/run_odometry.hpp"
 #include "ulc/core/pose_error.hpp"
 
 using namespace jeep_test;
@@ -53,8 +53,8 @@ TEST_CASE("single-LiDAR odometry follows the simulated drive", "[jeep][odometry]
   const auto& d = odometry_drive();
   const auto& a = d.lidars[0];
   REQUIRE(a.frames.size() >= 8);
-  const auto r = jeep::run_single_odometry(a.frames, a.timestamps);
-  INFO(jeep::to_string(r.status) << ": " << r.reason);
+  const auto r = odometry::run_single_odometry(a.frames, a.timestamps);
+  INFO(odometry::to_string(r.status) << ": " << r.reason);
   REQUIRE(r.ok());
   REQUIRE(r.poses_a.size() == a.frames.size());
   CHECK(r.poses_a[0].isApprox(Isometry3d::Identity(), 1e-12));
@@ -72,8 +72,8 @@ TEST_CASE("multi-LiDAR odometry gives both LiDARs' poses in their own map frames
   const auto& a = d.lidars[0];
   const auto& b = d.lidars[1];
   const Isometry3d C = d.pairs[0].T_base_target;
-  const auto r = jeep::run_odometry(a.frames, a.timestamps, b.frames, b.timestamps, C);
-  INFO(jeep::to_string(r.status) << ": " << r.reason);
+  const auto r = odometry::run_odometry(a.frames, a.timestamps, b.frames, b.timestamps, C);
+  INFO(odometry::to_string(r.status) << ": " << r.reason);
   REQUIRE(r.ok());
   REQUIRE(r.pairs.size() == a.frames.size());
   // Map a: a's frame at its first timestamp; map b: b's frame at that same instant.
@@ -110,7 +110,7 @@ TEST_CASE("odometry poses unpaired frames by extrapolating the nearest pair", "[
     times_b.push_back(b.timestamps[k]);
   }
   const Isometry3d C = d.pairs[0].T_base_target;
-  const auto r = jeep::run_odometry(a.frames, a.timestamps, frames_b, times_b, C);
+  const auto r = odometry::run_odometry(a.frames, a.timestamps, frames_b, times_b, C);
   REQUIRE(r.ok());
   CHECK(r.pairs.size() == a.frames.size() - 2);
   REQUIRE(r.poses_a.size() == a.frames.size());
@@ -130,15 +130,15 @@ TEST_CASE("odometry recovers from a prediction 40 cm off along the road", "[jeep
   // the default steps (coarse, then fine) must pull it back, or the odometry runs away.
   const auto& a = odometry_drive().lidars[0];
   REQUIRE(a.frames.size() >= 6);
-  const jeep::OdometryOptions options;
+  const odometry::OdometryOptions options;
   const double period = a.timestamps[1] - a.timestamps[0];
   // Frames 0..4 as run_odometry steps them; the last step gives the reference pose.
   auto run = [&](const std::optional<Isometry3d>& last_guess) {
-    jeep::Odometry<float> odometry(options);
-    jeep::OdometryStep last;
+    odometry::Odometry<float> odometry(options);
+    odometry::OdometryStep last;
     for (std::size_t k = 0; k < 5; ++k) {
       const auto scan =
-          jeep::prepare_scan<float>(a.frames[k], odometry.twist(), period, options.scan);
+          odometry::prepare_scan<float>(a.frames[k], odometry.twist(), period, options.scan);
       last = odometry.step(scan, a.timestamps[k], nullptr, a.timestamps[k],
                            k == 4 ? last_guess : std::nullopt);
     }
@@ -162,7 +162,7 @@ TEST_CASE("odometry gives the same bits on 1 and 2 threads", "[jeep][odometry][t
   const auto& b = d.lidars[1];
   const Isometry3d C = d.pairs[0].T_base_target;
   auto run = [&] {
-    return jeep::run_odometry(a.frames, a.timestamps, b.frames, b.timestamps, C).poses_b;
+    return odometry::run_odometry(a.frames, a.timestamps, b.frames, b.timestamps, C).poses_b;
   };
   tbb::task_arena one(1), two(2);
   const auto p1 = one.execute(run);
@@ -176,14 +176,15 @@ TEST_CASE("odometry refuses unusable input", "[jeep][odometry]") {
   const auto& a = odometry_drive().lidars[0];
   std::vector<double> bad = a.timestamps;
   bad[2] = bad[1] - 1.0;
-  CHECK(jeep::run_single_odometry(a.frames, bad).status == jeep::OdometryStatus::invalid_input);
+  CHECK(odometry::run_single_odometry(a.frames, bad).status ==
+        odometry::OdometryStatus::invalid_input);
   std::vector<double> short_times(a.timestamps.begin(), a.timestamps.end() - 1);
-  CHECK(jeep::run_single_odometry(a.frames, short_times).status ==
-        jeep::OdometryStatus::invalid_input);
-  jeep::OdometryOptions o;
+  CHECK(odometry::run_single_odometry(a.frames, short_times).status ==
+        odometry::OdometryStatus::invalid_input);
+  odometry::OdometryOptions o;
   o.scan.map_voxel = -1;
-  CHECK(jeep::run_single_odometry(a.frames, a.timestamps, o).status ==
-        jeep::OdometryStatus::invalid_input);
+  CHECK(odometry::run_single_odometry(a.frames, a.timestamps, o).status ==
+        odometry::OdometryStatus::invalid_input);
   const std::vector<ulc::PointCloud<float>> none;
-  CHECK(jeep::run_single_odometry(none, {}).status == jeep::OdometryStatus::no_pairs);
+  CHECK(odometry::run_single_odometry(none, {}).status == odometry::OdometryStatus::no_pairs);
 }

@@ -3,7 +3,7 @@
 #include <cstdio>
 #include <vector>
 
-#include "ulc/calibrate.hpp"
+#include "pipeline/calibrate.hpp"
 
 struct UserPoint {
   float x, y, z;

@@ -7,14 +7,14 @@
 //     holds every stage key of docs/design.md ("terra", "jeep", "odometry", "hots", "total"), 0
 //     for a stage that did not run.
 //   - Angles in the stage objects are degrees, distances metres, times seconds.
-// An I/O-side header of component ulc::results (it builds ulc::io::Json, nlohmann::ordered_json):
-// the pipeline's headers hold no JSON, and unlike ulc/calibrate.hpp this is not part of the
+// An I/O-side header of component ulc::results (it builds ulc::Json, nlohmann::ordered_json):
+// the pipeline's headers hold no JSON, and unlike pipeline/calibrate.hpp this is not part of the
 // -fno-exceptions promise.
 #pragma once
 
 #include <string>
 
-#include "ulc/calibrate/pair_calibration.hpp"
+#include "pipeline/pair_calibration.hpp"
 #include "ulc/core/lie.hpp"
 #include "ulc/io/json_file.hpp"
 #include "ulc/io/result_file.hpp"
@@ -38,7 +38,7 @@ inline Json local_map_stats(const LocalMapStats& m) {
   j["stacked_points"] = m.stacked_points;
   j["points"] = m.points;
   j["voxel_m"] = m.voxel_used;
-  j["odometry_status"] = m.odometry_status;
+  j["odometry_status"] = odometry::to_string(m.odometry_status);
   j["odometry_reason"] = m.odometry_reason;
   j["odometry_failed_steps"] = m.odometry_failed_steps;
   j["seconds"] = m.seconds;
@@ -53,7 +53,7 @@ inline Json local_map_stats(const LocalMapStats& m) {
 inline Json terra_to_json(const TerraReport& t) {
   using result_detail::stage_stats;
   Json j = Json::object();
-  j["status"] = t.status;
+  j["status"] = terra::to_string(t.status);
   j["reason"] = t.reason;
   j["frame_index"] = t.frame_index;
   j["rpy_deg"] = vector_to_json(rpy_from_rotation(t.rotation) * result_detail::kDegPerRad);
@@ -74,22 +74,24 @@ inline Json terra_to_json(const TerraReport& t) {
   j["rotations_evaluated"] = t.stats.rotations();
   j["descriptor_seconds"] = t.stats.descriptor_seconds;
   j["seconds"] = t.seconds;
-  j["source"] = t.source;
+  j["source"] = to_string(t.source);
   j["source_reason"] = t.source_reason;
   if (t.frames_mask_count) {
     j["frames_mask_count"] = *t.frames_mask_count;
-    j["frames_status"] = t.frames_status;
+    j["frames_status"] = terra::to_string(t.frames_status);
   }
   if (t.base_map) j["base_map"] = result_detail::local_map_stats(*t.base_map);
   if (t.target_map) j["target_map"] = result_detail::local_map_stats(*t.target_map);
   Json hypotheses = Json::array();
   for (const TerraHypothesis& h : t.hypotheses) {
     Json e = Json::object();
-    e["source"] = h.source;
+    e["source"] = to_string(h.source);
     e["rpy_deg"] = vector_to_json(rpy_from_rotation(h.rotation) * result_detail::kDegPerRad);
     e["distance"] = h.distance;
     e["mask_count"] = h.mask_count;
-    e["outcome"] = h.outcome;
+    e["outcome"] = h.status == CalibrateStatus::ok
+                       ? std::string("ok")
+                       : std::string(to_string(h.status)) + ": " + h.reason;
     e["seconds"] = h.seconds;
     hypotheses.push_back(std::move(e));
   }
@@ -101,12 +103,12 @@ inline Json terra_to_json(const TerraReport& t) {
 /// stages.jeep: rounds, status and the last calibration phase's cost and inliers.
 inline Json jeep_to_json(const JeepReport& r) {
   Json j = Json::object();
-  j["status"] = r.status;
+  j["status"] = jeep::to_string(r.status);
   j["reason"] = r.reason;
   j["rounds"] = r.rounds;
   j["frame_pairs"] = r.frame_pairs;
   j["initial_T_base_target"] = matrix_to_json(r.initial.matrix());
-  j["calibration_status"] = r.calibration_status;
+  j["calibration_status"] = to_string(r.calibration_status);
   j["final_cost"] = r.final_cost;
   j["final_inliers"] = r.final_inliers;
   j["final_rmse_m"] = r.final_rmse;
@@ -119,18 +121,21 @@ inline Json jeep_to_json(const JeepReport& r) {
   j["two_way_gap_deg"] = r.two_way_gap_rotation * result_detail::kDegPerRad;
   j["start_basins"] = r.start_basins;
   j["start_chosen"] = r.start_chosen;
-  if (r.second_look) {
-    Json look = Json::object();
-    look["passed"] = r.second_look_passed;
-    look["returned"] = r.second_look_returned;
-    look["starts"] = r.second_look_starts;
-    j["second_look"] = look;
-  } else {
-    j["second_look"] = nullptr;
-  }
   j["judged_by_hots"] = r.judged_by_hots;
   j["seconds"] = r.seconds;
   return j;
+}
+
+/// stages.hots.status: hots::refine's status, or "skipped" / "not_run" when it did not run.
+inline std::string hots_status_text(const HotsReport& h) {
+  switch (h.run) {
+    case HotsRun::skipped:
+      return "skipped";
+    case HotsRun::odometry_failed:
+      return "not_run";
+    default:
+      return hots::to_string(h.status);
+  }
 }
 
 /// stages.hots: the odometry that fed it, the graph's and the time synchronisation's statistics
@@ -138,9 +143,9 @@ inline Json jeep_to_json(const JeepReport& r) {
 inline Json hots_to_json(const HotsReport& h) {
   const hots::RefineStatistics& s = h.statistics;
   Json j = Json::object();
-  j["status"] = h.status;
+  j["status"] = hots_status_text(h);
   j["reason"] = h.reason;
-  j["odometry_status"] = h.odometry_status;
+  j["odometry_status"] = odometry::to_string(h.odometry_status);
   j["odometry_reason"] = h.odometry_reason;
   j["odometry_failed_steps"] = h.odometry_failed_steps;
   j["frames_base"] = h.frames_base;

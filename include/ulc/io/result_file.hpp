@@ -5,7 +5,7 @@
 // success false, a status word and a human reason.
 //
 // Rig additions (additive: a reader that ignores unknown keys keeps working):
-//   - an entry calibrated through another LiDAR v (ulc/calibrate/rig.hpp) has "via": "<v>" and
+//   - an entry calibrated through another LiDAR v (pipeline/rig.hpp) has "via": "<v>" and
 //     "direct": {"status", "reason"} of the failed direct attempt; its T_base_target is the
 //     chain T_base_v * T_v_target, its stages are the v -> target calibration's. Entries
 //     calibrated directly have neither key.

@@ -33,12 +33,12 @@
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
 
-#include "jeep/options.hpp"
+#include "odometry/options.hpp"
 #include "ulc/core/registration_types.hpp"
 #include "ulc/core/types.hpp"
 #include "ulc/core/voxel.hpp"
 
-namespace jeep {
+namespace odometry {
 
 using ulc::Isometry3d;
 using ulc::Mat3d;
@@ -362,4 +362,4 @@ class LocalMap {
   std::optional<Vec3d> last_prune_position_;
 };
 
-}  // namespace jeep
+}  // namespace odometry

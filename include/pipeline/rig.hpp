@@ -43,9 +43,9 @@
 #include <string>
 #include <vector>
 
-#include "ulc/calibrate.hpp"
-#include "ulc/calibrate/pair_calibration.hpp"
-#include "ulc/calibrate/stages.hpp"
+#include "pipeline/calibrate.hpp"
+#include "pipeline/pair_calibration.hpp"
+#include "pipeline/stages.hpp"
 #include "ulc/core/pose_error.hpp"
 #include "ulc/core/types.hpp"
 

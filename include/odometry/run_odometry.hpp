@@ -24,27 +24,13 @@
 #include <type_traits>
 #include <vector>
 
-#include "jeep/frame_pairing.hpp"
-#include "jeep/odometry.hpp"
-#include "jeep/scan_preparation.hpp"
+#include "odometry/frame_pairing.hpp"
+#include "odometry/odometry.hpp"
+#include "odometry/scan_preparation.hpp"
+#include "odometry/status.hpp"
 #include "ulc/core/point_traits.hpp"
 
-namespace jeep {
-
-enum class OdometryStatus { ok, invalid_input, no_pairs, registration_failed };
-
-inline const char* to_string(OdometryStatus s) {
-  switch (s) {
-    case OdometryStatus::ok:
-      return "ok";
-    case OdometryStatus::invalid_input:
-      return "invalid_input";
-    case OdometryStatus::no_pairs:
-      return "no_pairs";
-    default:
-      return "registration_failed";
-  }
-}
+namespace odometry {
 
 struct OdometryResult {
   OdometryStatus status = OdometryStatus::ok;
@@ -205,4 +191,4 @@ OdometryResult run_single_odometry(const Frames& frames, const std::vector<doubl
                                         progress);
 }
 
-}  // namespace jeep
+}  // namespace odometry

@@ -1,5 +1,5 @@
 // TERRA's hypotheses: the distinct optima of one search, best first, for the pipeline to verify
-// in turn (calibrate.hpp, CalibrateOptions::terra_hypotheses).
+// in turn (calibrate.hpp, CalibrateOptions::tuning.hypotheses.count).
 //
 // Why: on small-FoV pairs (a Tele-15 against a spinning LiDAR) the lowest eq:feature_dis is
 // often not the true rotation but the street's forward/backward twin (~166 deg of yaw) or a

@@ -13,7 +13,7 @@
 //     anchors were too and the rotation between the two maps' frames is R_base_target: the
 //     search result means what a frame search's does.
 //   - Each frame is deskewed to its timestamp with its odometry step's twist
-//     (jeep::prepare_scan with `scan`), placed with its pose at that timestamp, and the stack
+//     (odometry::prepare_scan with `scan`), placed with its pose at that timestamp, and the stack
 //     is thinned by voxel centroids; the voxel doubles until the map holds at most max_points
 //     (a bounded descriptor cost, whatever the window).
 //   - An odometry that could not register some frames (registration_failed) still gives a
@@ -31,12 +31,12 @@
 #include <string>
 #include <vector>
 
-#include "jeep/frame_pairing.hpp"
-#include "jeep/run_odometry.hpp"
-#include "jeep/scan_preparation.hpp"
+#include "odometry/frame_pairing.hpp"
+#include "odometry/run_odometry.hpp"
+#include "odometry/scan_preparation.hpp"
+#include "pipeline/map_terra_options.hpp"
 #include "terra/lattice.hpp"
 #include "terra/search.hpp"
-#include "ulc/calibrate/map_terra_options.hpp"
 #include "ulc/core/point_cloud.hpp"
 #include "ulc/core/point_traits.hpp"
 #include "ulc/core/types.hpp"
@@ -95,14 +95,14 @@ inline double seconds_since(std::chrono::steady_clock::time_point t0) {
 template <class Frames>
 auto build_local_map(const Frames& frames, const std::vector<double>& times, std::size_t first,
                      const MapTerraOptions& options = {}) {
-  using S = traits::scalar_t<jeep::detail::frame_cloud_t<Frames>>;
+  using S = traits::scalar_t<odometry::detail::frame_cloud_t<Frames>>;
   using namespace map_terra_detail;
   const auto t0 = std::chrono::steady_clock::now();
   LocalMap<S> map;
   const std::size_t n = frames.size() == times.size() ? window_frames(times, first, options) : 0;
   map.stats.frames = n;
   if (n == 0) {
-    map.stats.odometry_status = jeep::to_string(jeep::OdometryStatus::invalid_input);
+    map.stats.odometry_status = odometry::OdometryStatus::invalid_input;
     map.stats.odometry_reason =
         "no frame in the window (frame index past the end, or frame "
         "and timestamp counts differ)";
@@ -111,21 +111,21 @@ auto build_local_map(const Frames& frames, const std::vector<double>& times, std
   const FrameWindow<Frames> window(frames, first, n);
   const std::vector<double> t(times.begin() + static_cast<std::ptrdiff_t>(first),
                               times.begin() + static_cast<std::ptrdiff_t>(first + n));
-  const jeep::OdometryResult odo = jeep::run_single_odometry(window, t, options.odometry);
-  map.stats.odometry_status = jeep::to_string(odo.status);
+  const odometry::OdometryResult odo = odometry::run_single_odometry(window, t, options.odometry);
+  map.stats.odometry_status = odo.status;
   map.stats.odometry_reason = odo.reason;
   map.stats.odometry_failed_steps = odo.failed_steps;
-  if (!(odo.ok() || odo.status == jeep::OdometryStatus::registration_failed) ||
+  if (!(odo.ok() || odo.status == odometry::OdometryStatus::registration_failed) ||
       odo.steps.size() != n) {
     map.stats.seconds = seconds_since(t0);
     return map;
   }
   // Stack the deskewed frames at their poses (steps are the frames, in order).
-  const double period = jeep::frame_period(t);
+  const double period = odometry::frame_period(t);
   PointCloud<S> stack;
   for (std::size_t k = 0; k < n; ++k) {
-    const jeep::OdometryStep& step = odo.steps[k];
-    const auto scan = jeep::prepare_scan<S>(window[k], step.twist, period, options.scan);
+    const odometry::OdometryStep& step = odo.steps[k];
+    const auto scan = odometry::prepare_scan<S>(window[k], step.twist, period, options.scan);
     for (const auto& p : scan.dense)
       stack.points.push_back((step.pose_a * p.template cast<double>()).template cast<S>());
   }
@@ -174,7 +174,7 @@ MapTerraResult map_terra(const terra::Lattice& lattice, const FramesA& frames_a,
     const LocalMapStats& bad = map_a.ok ? r.target : r.base;
     r.search.status = terra::SearchStatus::invalid_input;
     r.search.reason = std::string(map_a.ok ? "target" : "base") + " local map: odometry " +
-                      bad.odometry_status + ": " + bad.odometry_reason;
+                      odometry::to_string(bad.odometry_status) + ": " + bad.odometry_reason;
     r.seconds = map_terra_detail::seconds_since(t0);
     return r;
   }

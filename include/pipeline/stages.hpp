@@ -4,8 +4,6 @@
 //   - Stages always run in pipeline order: terra -> jeep -> hots (docs/design.md, "The house").
 //     A stage list names each stage at most once, in that order; parse_stages says why a list
 //     is not usable instead of reordering it silently.
-//   - stage_available() says whether this build can run a stage (all three can now; it stays
-//     so that a future stage can be named before it lands).
 //   - Nothing here throws (algorithm-header rules).
 #pragma once
 
@@ -25,11 +23,6 @@ inline const char* to_string(Stage s) {
     default:
       return "hots";
   }
-}
-
-/// Whether this build can run the stage.
-inline bool stage_available(Stage s) {
-  return s == Stage::terra || s == Stage::jeep || s == Stage::hots;
 }
 
 inline bool has_stage(const std::vector<Stage>& stages, Stage s) {

@@ -1,11 +1,13 @@
-// The options of TERRA on local maps (map_terra.hpp) and what it reports of each map, apart
-// from the algorithm so that ulc/calibrate/options.hpp and pair_calibration.hpp stay light.
+// The options of TERRA's input (single frames or local maps, map_terra.hpp) and what it reports
+// of each map, apart from the algorithm so that pipeline/options.hpp and
+// pair_calibration.hpp stay light.
 #pragma once
 
 #include <cstddef>
 #include <string>
 
-#include "jeep/options.hpp"
+#include "odometry/options.hpp"
+#include "odometry/status.hpp"
 
 namespace ulc {
 
@@ -30,14 +32,14 @@ struct MapTerraOptions {
   double d1 = 7.0;
   double voxel = 0.2;               ///< m, thinning of the stacked map (doubled to fit max_points)
   std::size_t max_points = 300000;  ///< bound on each map's size
-  jeep::OdometryOptions odometry;   ///< each LiDAR's own odometry over the window
+  odometry::OdometryOptions odometry;  ///< each LiDAR's own odometry over the window
   /// How each frame enters its map: the range gate keeps the vehicle out (min_range) but lets
   /// far returns in (TERRA's mask only compares cells beyond d1 = 20 m); the map voxel is the
   /// first thinning, before the stack's.
-  jeep::ScanOptions scan = default_scan();
+  odometry::ScanOptions scan = default_scan();
 
-  static jeep::ScanOptions default_scan() {
-    jeep::ScanOptions s;
+  static odometry::ScanOptions default_scan() {
+    odometry::ScanOptions s;
     s.min_range = 2.0;
     s.max_range = 500.0;
     s.map_voxel = 0.2;
@@ -46,13 +48,44 @@ struct MapTerraOptions {
   }
 };
 
+/// What TERRA compares: single frames (the paper's default) or each LiDAR's local map over a
+/// short window (the paper's remedy for small overlap, map_terra.hpp).
+enum class TerraSource {
+  automatic,  ///< frames first; maps when the sequences allow and the frames overlap too little
+  frames,     ///< frame frame_index of each LiDAR
+  maps        ///< local maps from frame_index on (a single frame gives a one-frame map)
+};
+
+inline const char* to_string(TerraSource s) {
+  switch (s) {
+    case TerraSource::automatic:
+      return "automatic";
+    case TerraSource::frames:
+      return "frames";
+    default:
+      return "maps";
+  }
+}
+
+/// The TERRA stage's choice of input (pipeline.hpp, terra_stage).
+struct TerraSourceOptions {
+  TerraSource source = TerraSource::automatic;
+  /// automatic: the maps are tried only when each LiDAR has at least this many frames in the
+  /// window from frame_index (a single frame, or a static snapshot, stays on frames) ...
+  std::size_t maps_min_frames = 5;
+  /// ... and the frame search failed or its eq:mask count at its answer is below this many
+  /// cells. The map result is then kept when it succeeded with a larger mask count.
+  std::size_t maps_below_mask = 100;
+  MapTerraOptions maps;  ///< window, thinning and odometry of the local maps
+};
+
 /// One LiDAR's local map and how it was made.
 struct LocalMapStats {
   std::size_t frames = 0;          ///< frames in the window (stacked into the map)
   std::size_t stacked_points = 0;  ///< points before the stack's thinning
   std::size_t points = 0;          ///< map points given to TERRA
   double voxel_used = 0.0;         ///< m, the stack's thinning voxel after fitting max_points
-  std::string odometry_status;     ///< jeep::to_string(OdometryStatus)
+  odometry::OdometryStatus odometry_status = odometry::OdometryStatus::ok;
   std::string odometry_reason;
   std::size_t odometry_failed_steps = 0;
   double seconds = 0.0;  ///< odometry and map building

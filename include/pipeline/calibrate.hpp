@@ -1,23 +1,23 @@
 // ulc::calibrate_pair: the extrinsic T_base_target of a target LiDAR b against a base LiDAR a,
 // from each LiDAR's frames and timestamps, with no initial guess (TERRA, JEEP, odometry, HOTS;
-// the conventions are those of ulc/calibrate/pipeline.hpp, which runs the stages).
+// the conventions are those of pipeline/pipeline.hpp, which runs the stages).
 //
 // This header is light: it includes the options and result types, never the algorithms, so a
 // file that calls the pipeline compiles in seconds (docs/BENCHMARKS.md, "Compile time"). The
 // pipeline itself runs on ulc::PointCloud<float> frames and is compiled once:
 //   - link the CMake target ulc::calibrate (a static library of that one file), or
-//   - header-only: include ulc/calibrate/implementation.hpp in exactly one file of your program.
+//   - header-only: include pipeline/implementation.hpp in exactly one file of your program.
 // Frames of any other type (your own point struct, through ulc::traits) are adapted once at the
 // entry: points as float, with the per-point times and intensities the type has. To read them in
-// place instead, call calibrate_pair_in_place (ulc/calibrate/pipeline.hpp): every stage is then
+// place instead, call calibrate_pair_in_place (pipeline/pipeline.hpp): every stage is then
 // compiled for your type, which takes minutes per file.
 #pragma once
 
 #include <type_traits>
 #include <vector>
 
-#include "ulc/calibrate/options.hpp"
-#include "ulc/calibrate/pair_calibration.hpp"
+#include "pipeline/options.hpp"
+#include "pipeline/pair_calibration.hpp"
 #include "ulc/core/point_cloud.hpp"
 #include "ulc/core/point_traits.hpp"
 
@@ -26,7 +26,7 @@ namespace ulc {
 /// The frames the compiled pipeline reads.
 using FloatFrames = std::vector<PointCloud<float>>;
 
-/// The pipeline on PointCloud<float> frames (defined in ulc/calibrate/implementation.hpp).
+/// The pipeline on PointCloud<float> frames (defined in pipeline/implementation.hpp).
 PairCalibration calibrate_pair(const FloatFrames& frames_a, const std::vector<double>& times_a,
                                const FloatFrames& frames_b, const std::vector<double>& times_b,
                                const CalibrateOptions& options = {});

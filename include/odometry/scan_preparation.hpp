@@ -17,7 +17,7 @@
 #include <cstddef>
 #include <vector>
 
-#include "jeep/options.hpp"
+#include "odometry/options.hpp"
 #include "ulc/core/cloud.hpp"
 #include "ulc/core/deskew.hpp"
 #include "ulc/core/lie.hpp"
@@ -26,7 +26,7 @@
 #include "ulc/core/types.hpp"
 #include "ulc/core/voxel_downsample.hpp"
 
-namespace jeep {
+namespace odometry {
 
 inline bool valid_scan_options(const ScanOptions& o) {
   return o.min_range >= 0.0 && o.max_range > o.min_range && o.map_voxel > 0.0 &&
@@ -77,4 +77,4 @@ PreparedScan<S> prepare_scan(const Cloud& cloud, const ulc::Vec6d& xi, double du
   return out;
 }
 
-}  // namespace jeep
+}  // namespace odometry

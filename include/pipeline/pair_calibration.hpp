@@ -1,4 +1,4 @@
-// What calibrate_pair (ulc/calibrate.hpp) returns for one base/target pair. Light: it includes
+// What calibrate_pair (pipeline/calibrate.hpp) returns for one base/target pair. Light: it includes
 // no algorithm, so that a file calling the pipeline compiles in seconds.
 //
 // Conventions this header owns:
@@ -21,21 +21,23 @@
 #include <vector>
 
 #include "hots/refine_statistics.hpp"
+#include "jeep/status.hpp"
+#include "odometry/status.hpp"
+#include "pipeline/map_terra_options.hpp"
+#include "pipeline/stages.hpp"
 #include "terra/search_params.hpp"
-#include "ulc/calibrate/map_terra_options.hpp"
-#include "ulc/calibrate/stages.hpp"
+#include "ulc/core/registration_types.hpp"
 #include "ulc/core/types.hpp"
 
 namespace ulc {
 
 enum class CalibrateStatus {
   ok,
-  invalid_input,        ///< bad options, empty inputs, frame_index past the end
-  initial_required,     ///< no terra stage and no initial extrinsic
-  stage_not_available,  ///< a stage this build cannot run
-  terra_failed,         ///< TERRA found no rotation (see terra->status)
-  jeep_failed,          ///< JEEP did not converge or its result was rejected (see jeep->status)
-  hots_failed           ///< the odometry before HOTS or HOTS itself failed (see hots->status)
+  invalid_input,     ///< bad options, empty inputs, frame_index past the end
+  initial_required,  ///< no terra stage and no initial extrinsic
+  terra_failed,      ///< TERRA found no rotation (see terra->status)
+  jeep_failed,       ///< JEEP did not converge or its result was rejected (see jeep->status)
+  hots_failed        ///< the odometry before HOTS or HOTS itself failed (see hots->status)
 };
 
 inline const char* to_string(CalibrateStatus s) {
@@ -46,8 +48,6 @@ inline const char* to_string(CalibrateStatus s) {
       return "invalid_input";
     case CalibrateStatus::initial_required:
       return "initial_required";
-    case CalibrateStatus::stage_not_available:
-      return "stage_not_available";
     case CalibrateStatus::terra_failed:
       return "terra_failed";
     case CalibrateStatus::jeep_failed:
@@ -60,19 +60,20 @@ inline const char* to_string(CalibrateStatus s) {
 /// One of TERRA's hypotheses the pipeline started from (terra_hypotheses.hpp) and what became of
 /// it.
 struct TerraHypothesis {
-  std::string source = "frames";       ///< "frames" or "maps": the search it is an optimum of
-  Mat3d rotation = Mat3d::Identity();  ///< R_base_target
-  double distance = 0.0;               ///< eq:feature_dis
-  std::size_t mask_count = 0;          ///< eq:mask cells
-  std::string outcome;                 ///< "ok", or the calibration status and reason it ended with
-  double seconds = 0.0;                ///< JEEP, odometry and HOTS from this hypothesis
+  TerraSource source = TerraSource::frames;      ///< frames or maps: the search it is an optimum of
+  Mat3d rotation = Mat3d::Identity();            ///< R_base_target
+  double distance = 0.0;                         ///< eq:feature_dis
+  std::size_t mask_count = 0;                    ///< eq:mask cells
+  CalibrateStatus status = CalibrateStatus::ok;  ///< how the stages from it ended
+  std::string reason;                            ///< why, when status is not ok
+  double seconds = 0.0;                          ///< JEEP, odometry and HOTS from this hypothesis
 };
 
 /// The TERRA stage: a rotation from one frame of each LiDAR, or from each LiDAR's local map
 /// over a short window from that frame (map_terra.hpp), no prior. The fields above `source`
 /// describe the search whose rotation was kept.
 struct TerraReport {
-  std::string status;  ///< terra::to_string(SearchStatus)
+  terra::SearchStatus status = terra::SearchStatus::ok;
   std::string reason;
   Mat3d rotation = Mat3d::Identity();  ///< R_base_target found
   double distance = 0.0;               ///< eq:feature_dis at the rotation
@@ -80,14 +81,15 @@ struct TerraReport {
   std::size_t frame_index = 0;         ///< the frame of each LiDAR used (the maps' first)
   std::size_t base_points = 0, target_points = 0;  ///< of the frames, or of the maps
   std::size_t lattice_size = 0;
-  terra::SearchStats stats;       ///< rotations and seconds per stage, d1 used, ...
-  double seconds = 0.0;           ///< the whole stage, lattice, maps and descriptors included
-  std::string source = "frames";  ///< "frames" or "maps": what the kept search compared
-  std::string source_reason;      ///< why (CalibrateOptions::terra_source, automatic rule)
+  terra::SearchStats stats;  ///< rotations and seconds per stage, d1 used, ...
+  double seconds = 0.0;      ///< the whole stage, lattice, maps and descriptors included
+  TerraSource source = TerraSource::frames;  ///< what the kept search compared
+  std::string
+      source_reason;  ///< why (CalibrateOptions::tuning.terra_source.source, automatic rule)
   /// The single-frame search's mask count and status when it ran (automatic runs it first and
   /// keeps it unless its overlap is small), whatever source was kept.
   std::optional<std::size_t> frames_mask_count;
-  std::string frames_status;
+  terra::SearchStatus frames_status = terra::SearchStatus::ok;
   std::optional<LocalMapStats> base_map, target_map;  ///< when the map search ran
   /// The hypotheses the later stages started from, in the order tried (the first is the
   /// search's best, `rotation`), and the index of the one the result comes from (the first
@@ -98,13 +100,14 @@ struct TerraReport {
 
 /// The JEEP stage: extrinsic and poses over the first K frame pairs.
 struct JeepReport {
-  std::string status;  ///< jeep::to_string(JeepStatus)
+  jeep::JeepStatus status = jeep::JeepStatus::ok;
   std::string reason;
   Isometry3d initial = Isometry3d::Identity();    ///< the extrinsic JEEP started from
   Isometry3d extrinsic = Isometry3d::Identity();  ///< JEEP's last extrinsic (even if failed)
   int rounds = 0;
-  std::size_t frame_pairs = 0;       ///< pairs used (<= JeepOptions::frames)
-  std::string calibration_status;    ///< of the last map-to-map registration
+  std::size_t frame_pairs = 0;  ///< pairs used (<= JeepOptions::frames)
+  RegistrationStatus calibration_status =
+      RegistrationStatus::ok;        ///< of the last map-to-map registration
   double final_cost = 0.0;           ///< of the last map-to-map registration
   std::size_t final_inliers = 0;     ///< of the last map-to-map registration
   double final_rmse = 0.0;           ///< m
@@ -120,23 +123,25 @@ struct JeepReport {
   /// scored, and the start whose basin won (0: the initial extrinsic's own).
   std::size_t start_basins = 0;
   std::size_t start_chosen = 0;
-  /// The second look at a refusal for the off-ground overlap alone (jeep/second_look.hpp):
-  /// whether it ran, and how many of its starts came back to the extrinsic.
-  bool second_look = false;
-  bool second_look_passed = false;
-  std::size_t second_look_returned = 0;
-  std::size_t second_look_starts = 0;
   /// JEEP failed (rejected or not settled) and HOTS ran from its extrinsic to judge it
-  /// (CalibrateOptions::hots_judges_jeep): the pair's status says which won.
+  /// (CalibrateOptions::tuning.hypotheses.hots_judges_jeep): the pair's status says which won.
   bool judged_by_hots = false;
   double seconds = 0.0;
 };
 
+/// How far the HOTS stage got.
+enum class HotsRun {
+  refined,          ///< hots::refine ran: HotsReport::status says how it ended
+  skipped,          ///< too few frames for HOTS: the previous stage's extrinsic stands
+  odometry_failed,  ///< the odometry before it gave no poses: HOTS did not run
+};
+
 /// The HOTS stage: odometry over every frame from frame_index, then hots::refine.
 struct HotsReport {
-  std::string status;  ///< hots::to_string(RefineStatus), or "not_run" when odometry failed
+  HotsRun run = HotsRun::refined;
+  hots::RefineStatus status = hots::RefineStatus::ok;  ///< when run is refined
   std::string reason;
-  std::string odometry_status;  ///< jeep::to_string(OdometryStatus)
+  odometry::OdometryStatus odometry_status = odometry::OdometryStatus::ok;
   std::string odometry_reason;
   std::size_t frames_base = 0, frames_target = 0;  ///< frames given to odometry and HOTS
   std::size_t odometry_failed_steps = 0;

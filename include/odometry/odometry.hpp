@@ -29,16 +29,16 @@
 #include <type_traits>
 #include <vector>
 
-#include "jeep/frame_pairing.hpp"
-#include "jeep/local_map.hpp"
-#include "jeep/options.hpp"
-#include "jeep/scan_preparation.hpp"
+#include "odometry/frame_pairing.hpp"
+#include "odometry/local_map.hpp"
+#include "odometry/options.hpp"
+#include "odometry/scan_preparation.hpp"
 #include "ulc/core/lie.hpp"
 #include "ulc/core/point_to_plane.hpp"
 #include "ulc/core/registration_types.hpp"
 #include "ulc/core/types.hpp"
 
-namespace jeep {
+namespace odometry {
 
 using ulc::RegistrationOptions;
 using ulc::RegistrationStatus;
@@ -240,4 +240,4 @@ class Odometry {
   bool has_velocity_ = false;
 };
 
-}  // namespace jeep
+}  // namespace odometry

@@ -16,7 +16,7 @@
 #include <limits>
 #include <vector>
 
-namespace jeep {
+namespace odometry {
 
 struct FramePair {
   std::size_t a = 0;  ///< index into a's frames
@@ -70,4 +70,4 @@ inline std::vector<FramePair> pair_frames(const std::vector<double>& times_a,
   return pairs;
 }
 
-}  // namespace jeep
+}  // namespace odometry

@@ -1,10 +1,10 @@
-// The definition of ulc::calibrate_pair on PointCloud<float> frames (ulc/calibrate.hpp): the
+// The definition of ulc::calibrate_pair on PointCloud<float> frames (pipeline/calibrate.hpp): the
 // whole pipeline, compiled in the one file that includes this header. The CMake target
 // ulc::calibrate is that file; a header-only user includes this header in exactly one of theirs.
 #pragma once
 
-#include "ulc/calibrate.hpp"
-#include "ulc/calibrate/pipeline.hpp"
+#include "pipeline/calibrate.hpp"
+#include "pipeline/pipeline.hpp"
 
 namespace ulc {
 

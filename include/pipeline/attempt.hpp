@@ -1,0 +1,268 @@
+// One attempt of the pipeline: the stages after TERRA (JEEP, then the odometry and HOTS) from
+// one starting extrinsic, on the frames from frame_index on.
+//
+//   - JEEP (jeep.hpp) over the first JeepOptions::frames frame pairs. When it fails and HOTS may
+//     judge it (HypothesisOptions::hots_judges_jeep, a moving rig, a finite extrinsic), HOTS
+//     runs from JEEP's extrinsic and decides: its success overrules JEEP, its refusal is JEEP's
+//     failure.
+//   - HOTS: the multi-LiDAR odometry (StageTuning::odometry) over ALL frames from frame_index,
+//     then hots::refine on those frames and poses. An odometry that could not register some
+//     frames still feeds HOTS (its poses are predictions there); one that gives no poses ends
+//     the attempt. With fewer than StageTuning::hots_min_frames frames per LiDAR HOTS is
+//     skipped after TERRA or JEEP (a static snapshot has no motion for it).
+//   - A failure "points at the start" when JEEP failed or HOTS's cross links refused the
+//     extrinsic (extrinsic_unconfirmed): the next TERRA hypothesis is then worth a try.
+//   - Progress: "jeep", "odometry", "hots", with the attempt's label (" (hypothesis k)").
+#pragma once
+
+#include <chrono>
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "hots/hots.hpp"
+#include "jeep/jeep.hpp"
+#include "odometry/run_odometry.hpp"
+#include "pipeline/options.hpp"
+#include "pipeline/pair_calibration.hpp"
+#include "ulc/core/frame_range.hpp"
+#include "ulc/core/lidar_sequence.hpp"
+
+namespace ulc {
+namespace calibrate_detail {
+
+inline double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// What every attempt reads: both LiDARs' sequences from frame_index on (b's timestamps on a's
+/// clock when the offset is known), the options and which stages run.
+template <class FramesA, class FramesB>
+struct AttemptInputs {
+  LidarSequence<FrameRange<FramesA>> a;
+  LidarSequence<FrameRange<FramesB>> b;
+  const CalibrateOptions& options;
+  hots::RefineOptions hots;  ///< StageTuning::hots with a known clock offset applied
+  bool run_terra = false, run_jeep = false, run_hots = false;
+  /// HOTS runs, on a moving rig: it can judge a start.
+  bool can_verify() const { return run_hots && frames_left() >= options.tuning.hots_min_frames; }
+  std::size_t frames_left() const { return std::min(a.size(), b.size()); }
+};
+
+/// How the stages of one attempt ended, and whether the failure points at its start.
+struct StageOutcome {
+  CalibrateStatus status = CalibrateStatus::ok;
+  std::string reason;
+  bool points_at_start = false;
+};
+
+/// One attempt's running state.
+struct Attempt {
+  Isometry3d extrinsic;        ///< the stage's start, then its result
+  std::string label;           ///< "" or " (hypothesis k)", for progress
+  bool hots_may_judge = true;  ///< a failed JEEP may be judged by HOTS
+  std::string jeep_failure;    ///< set when JEEP failed and HOTS judges its extrinsic
+  PairCalibration& out;
+};
+
+inline void notify(const CalibrateOptions& o, const std::string& stage, double fraction) {
+  if (o.progress) o.progress(stage, fraction);
+}
+
+/// A stage's (done, total) counts as its fraction of the progress bar.
+inline odometry::ProgressFn count_progress(const CalibrateOptions& o, std::string stage) {
+  if (!o.progress) return {};
+  return [&o, stage](std::size_t done, std::size_t total) {
+    o.progress(stage, total ? static_cast<double>(done) / static_cast<double>(total) : 1.0);
+  };
+}
+
+inline JeepReport jeep_report(const jeep::JeepResult& j, const Isometry3d& initial,
+                              double seconds) {
+  JeepReport r;
+  r.status = j.status;
+  r.reason = j.reason;
+  r.initial = initial;
+  r.extrinsic = j.extrinsic;
+  r.rounds = j.rounds;
+  r.frame_pairs = j.pairs.size();
+  r.calibration_status = j.calibration.status;
+  r.final_cost = j.calibration.cost;
+  r.final_inliers = j.calibration.inliers;
+  r.final_rmse = j.calibration.rmse;
+  r.accepted = j.acceptance.accepted;
+  r.overlap = j.acceptance.overlap;
+  r.directional_overlap = j.acceptance.directional_overlap;
+  r.off_ground_overlap = j.acceptance.off_ground_overlap;
+  r.two_way = j.two_way.applied;
+  r.two_way_gap_translation = j.two_way.gap_translation;
+  r.two_way_gap_rotation = j.two_way.gap_rotation;
+  r.start_basins = j.start_search.basins;
+  r.start_chosen = j.start_search.chosen;
+  r.seconds = seconds;
+  return r;
+}
+
+/// A JEEP that ran to its end without a usable extrinsic's verdict (rejected, or not settled)
+/// with a finite extrinsic: HOTS can judge it (HypothesisOptions::hots_judges_jeep).
+inline bool hots_can_judge(jeep::JeepStatus status, const Isometry3d& extrinsic) {
+  return (status == jeep::JeepStatus::rejected || status == jeep::JeepStatus::not_converged) &&
+         extrinsic.matrix().allFinite();
+}
+
+/// The same from a JEEP stage's report (for callers that ran JEEP through calibrate_pair and
+/// run HOTS themselves, as the benchmarks do).
+inline bool hots_can_judge(const JeepReport& j) {
+  return hots_can_judge(j.status, j.extrinsic);
+}
+
+/// The JEEP stage; an outcome when it ends the attempt.
+template <class FA, class FB>
+std::optional<StageOutcome> jeep_step(const AttemptInputs<FA, FB>& in, Attempt& at) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::string stage = "jeep" + at.label;
+  notify(in.options, stage, 0.0);
+  const jeep::JeepResult j =
+      jeep::run_jeep(in.a.frames, in.a.times, in.b.frames, in.b.times, at.extrinsic,
+                     in.options.tuning.jeep, count_progress(in.options, stage));
+  at.out.jeep = jeep_report(j, at.extrinsic, seconds_since(t0));
+  at.out.timing_s.jeep = at.out.jeep->seconds;
+  notify(in.options, stage, 1.0);
+  if (!j.ok()) {
+    at.jeep_failure = std::string("JEEP: ") + jeep::to_string(j.status) + ": " + j.reason;
+    at.out.jeep->judged_by_hots = at.hots_may_judge &&
+                                  in.options.tuning.hypotheses.hots_judges_jeep &&
+                                  in.can_verify() && hots_can_judge(j.status, j.extrinsic);
+    if (!at.out.jeep->judged_by_hots)
+      return StageOutcome{CalibrateStatus::jeep_failed, at.jeep_failure, true};
+  }
+  at.extrinsic = j.extrinsic;
+  if (j.ok()) at.out.T_base_target = at.extrinsic;
+  return std::nullopt;
+}
+
+/// A failure after JEEP: when HOTS was judging a failed JEEP, HOTS's refusal is JEEP's failure.
+inline StageOutcome failed_after_jeep(const Attempt& at, CalibrateStatus status, std::string why,
+                                      bool points_at_start) {
+  if (at.jeep_failure.empty()) return StageOutcome{status, std::move(why), points_at_start};
+  return StageOutcome{CalibrateStatus::jeep_failed,
+                      at.jeep_failure + " (HOTS, run from its extrinsic to judge it: " + why + ")",
+                      points_at_start};
+}
+
+/// HOTS skipped for want of frames: the previous stage's extrinsic stands.
+template <class FA, class FB>
+StageOutcome skip_hots(const AttemptInputs<FA, FB>& in, Attempt& at) {
+  HotsReport h;
+  h.run = HotsRun::skipped;
+  h.reason = "only " + std::to_string(in.frames_left()) + " frame(s) per LiDAR from frame " +
+             std::to_string(in.options.frame_index) + " (HOTS needs " +
+             std::to_string(in.options.tuning.hots_min_frames) +
+             " of a moving rig); the extrinsic is the previous stage's";
+  h.initial = h.extrinsic = at.extrinsic;
+  at.out.hots = h;
+  return {CalibrateStatus::ok, "", false};
+}
+
+/// Odometry gave a pose to every frame (possibly predicted ones): HOTS can start.
+inline bool odometry_usable(const odometry::OdometryResult& odo) {
+  return odo.ok() || odo.status == odometry::OdometryStatus::registration_failed;
+}
+
+inline HotsReport odometry_report(const odometry::OdometryResult& odo, const Isometry3d& initial,
+                                  double odometry_seconds) {
+  HotsReport h;
+  h.run = odometry_usable(odo) ? HotsRun::refined : HotsRun::odometry_failed;
+  h.odometry_status = odo.status;
+  h.odometry_reason = odo.reason;
+  h.frames_base = odo.poses_a.size();
+  h.frames_target = odo.poses_b.size();
+  h.odometry_failed_steps = odo.failed_steps;
+  h.initial = initial;
+  h.extrinsic = initial;
+  h.odometry_seconds = odometry_seconds;
+  return h;
+}
+
+inline void add_refine(HotsReport& h, const hots::RefineResult& r, double seconds) {
+  h.status = r.status;
+  h.reason = r.reason;
+  h.extrinsic = r.extrinsic;
+  h.time_offset_s = r.time_offset_s;
+  h.covariance_6x6 = r.covariance_6x6;
+  h.statistics = r.statistics;
+  h.spread_curve = r.spread_curve;
+  h.seconds = seconds;
+}
+
+/// One sentence for a failed HOTS, with what to do about it.
+inline std::string hots_failure(const hots::RefineResult& h) {
+  std::string why = std::string("HOTS: ") + hots::to_string(h.status) + ": " + h.reason;
+  if (h.status == hots::RefineStatus::extrinsic_unconfirmed)
+    why += "; " + std::to_string(h.statistics.cross_links_agreeing) + " of " +
+           std::to_string(h.statistics.cross_links_attempted) +
+           " agree: the extrinsic before HOTS is likely wrong (TERRA's rotation or the initial "
+           "guess)";
+  if (h.status == hots::RefineStatus::time_offset_untrusted)
+    why +=
+        "; a longer drive with turns and speed changes pins it down, and synchronised clocks "
+        "are said so with time_offset_s = 0 (ulc calibrate --synced-clocks)";
+  return why;
+}
+
+/// The odometry over every frame, then hots::refine on its poses.
+template <class FA, class FB>
+StageOutcome hots_step(const AttemptInputs<FA, FB>& in, Attempt& at) {
+  const std::string odometry_stage = "odometry" + at.label, hots_stage = "hots" + at.label;
+  auto t0 = std::chrono::steady_clock::now();
+  notify(in.options, odometry_stage, 0.0);
+  const odometry::OdometryResult odo = odometry::run_odometry(
+      in.a.frames, in.a.times, in.b.frames, in.b.times, at.extrinsic, in.options.tuning.odometry,
+      count_progress(in.options, odometry_stage));
+  at.out.timing_s.odometry = seconds_since(t0);
+  at.out.hots = odometry_report(odo, at.extrinsic, at.out.timing_s.odometry);
+  if (at.out.hots->run == HotsRun::odometry_failed)
+    return failed_after_jeep(
+        at, CalibrateStatus::hots_failed,
+        std::string("HOTS: odometry: ") + odometry::to_string(odo.status) + ": " + odo.reason,
+        !at.jeep_failure.empty());
+  notify(in.options, odometry_stage, 1.0);
+  notify(in.options, hots_stage, 0.0);
+  auto a = in.a;
+  auto b = in.b;
+  a.poses = odo.poses_a;
+  b.poses = odo.poses_b;
+  t0 = std::chrono::steady_clock::now();
+  const hots::RefineResult h = hots::refine(a, b, at.extrinsic, in.hots);
+  at.out.timing_s.hots = seconds_since(t0);
+  add_refine(*at.out.hots, h, at.out.timing_s.hots);
+  at.out.hots->time_offset_s += at.out.time_offset_s;  // back to b's own clock
+  if (!h.ok())
+    return failed_after_jeep(
+        at, CalibrateStatus::hots_failed, hots_failure(h),
+        h.status == hots::RefineStatus::extrinsic_unconfirmed || !at.jeep_failure.empty());
+  notify(in.options, hots_stage, 1.0);
+  at.out.T_base_target = h.extrinsic;
+  at.out.time_offset_s += h.time_offset_s;
+  at.out.covariance_6x6 = h.covariance_6x6;
+  return {CalibrateStatus::ok, "", false};
+}
+
+/// JEEP and HOTS (as the stages ask) from `start`, into `out`.
+template <class FA, class FB>
+StageOutcome run_attempt(const AttemptInputs<FA, FB>& in, const Isometry3d& start,
+                         std::string label, bool hots_may_judge, PairCalibration& out) {
+  Attempt at{start, std::move(label), hots_may_judge, {}, out};
+  out.T_base_target = start;
+  if (in.run_jeep)
+    if (auto ended = jeep_step(in, at)) return *ended;
+  if (!in.run_hots) return {CalibrateStatus::ok, "", false};
+  if (in.frames_left() < in.options.tuning.hots_min_frames && (in.run_terra || in.run_jeep))
+    return skip_hots(in, at);
+  return hots_step(in, at);
+}
+
+}  // namespace calibrate_detail
+}  // namespace ulc

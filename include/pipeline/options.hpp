@@ -1,0 +1,60 @@
+// The options of ulc::calibrate_pair (pipeline/calibrate.hpp), in two tiers: CalibrateOptions holds
+// what a caller decides (stages, frames, clocks, threads, progress); StageTuning holds each
+// stage's own tuning, whose structs live beside their stages (docs/pipeline.md lists every
+// field). Light on purpose: it includes the stages' option headers only,
+// never the algorithms, so that a file calling the pipeline compiles in seconds
+// (docs/BENCHMARKS.md, "Compile time").
+#pragma once
+
+#include <cstddef>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "hots/options.hpp"
+#include "jeep/options.hpp"
+#include "odometry/options.hpp"
+#include "pipeline/hypothesis_options.hpp"
+#include "pipeline/map_terra_options.hpp"
+#include "pipeline/stages.hpp"
+#include "terra/search_params.hpp"
+#include "ulc/core/types.hpp"
+
+namespace ulc {
+
+/// Called with the running stage's name ("terra", "jeep", "odometry", "hots") and its fraction
+/// done.
+using CalibrateProgress = std::function<void(const std::string& stage, double fraction)>;
+
+/// Each stage's tuning; the defaults are the paper's where it gives one.
+struct StageTuning {
+  terra::SearchParams terra;        ///< N = 10000, d1 = 20 m, d2 = 5 m, alpha = 2, 10/1 deg strides
+  TerraSourceOptions terra_source;  ///< frames or local maps (map_terra_options.hpp)
+  HypothesisOptions hypotheses;     ///< TERRA's later optima tried in turn (not in the paper)
+  jeep::JeepOptions jeep;           ///< K = 5 frame pairs, at most 10 rounds
+  odometry::OdometryOptions odometry;  ///< the odometry over all frames that feeds HOTS
+  hots::RefineOptions hots;            ///< windows of 5, 3 layers, time synchronisation on
+  /// Single frames or a static rig (fewer frames than this per LiDAR from frame_index): HOTS
+  /// has no motion to work with, so after TERRA or JEEP it is skipped (stages.hots says so) and
+  /// their extrinsic is the answer; as the only stage it fails.
+  std::size_t hots_min_frames = 10;
+};
+
+/// What a caller of calibrate_pair decides.
+struct CalibrateOptions {
+  std::vector<Stage> stages{Stage::terra, Stage::jeep, Stage::hots};
+  std::size_t frame_index = 0;        ///< TERRA's frame, and the first frame of the others
+  std::optional<Isometry3d> initial;  ///< T_base_target guess, used when terra does not run
+  /// The clocks' offset when it is known (t_base = t_target + offset; 0 for synchronised
+  /// clocks): every stage reads b's timestamps moved onto a's clock, HOTS does not estimate an
+  /// offset (nor check one) and the result reports this one. Unset: HOTS estimates it.
+  std::optional<double> time_offset_s;
+  /// Worker threads for this call (a TBB arena of this size); 0 = TBB's default (all cores, or
+  /// the caller's own arena or global_control limit). The result does not depend on it.
+  std::size_t threads = 0;
+  CalibrateProgress progress;  ///< optional
+  StageTuning tuning;
+};
+
+}  // namespace ulc

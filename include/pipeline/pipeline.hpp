@@ -1,0 +1,292 @@
+// The calibration pipeline's top floor: one base LiDAR a and one target LiDAR b in, the
+// extrinsic T_base_target out (docs/design.md, "The house" and "Data flows one way"). This header
+// holds the whole pipeline as templates on the frames' type (calibrate_pair_in_place); a user's
+// file includes pipeline/calibrate.hpp instead, whose calibrate_pair runs it compiled once. The
+// TERRA stage is terra_stage.hpp; the stages after it, from one start, attempt.hpp.
+//
+//   frames of a, b -> TERRA(a[i], b[i])              -> R0 (translation zero)
+//                  -> JEEP(pairs from frame i on, R0) -> C1
+//                  -> odometry(all frames from i on, C1) -> poses
+//                  -> HOTS(all frames from i on, poses, C1) -> C2, clock offset, covariance
+//
+// Conventions this header owns (result conventions: calibrate/pair_calibration.hpp):
+//   - Inputs: the frames of each LiDAR (any random-access container of clouds with point traits,
+//     per-point times relative to the frame timestamp) and their timestamps (seconds, each
+//     LiDAR's own clock, one per frame).
+//   - frame_index i: TERRA uses frame i of each LiDAR (the same index, so clock offsets do not
+//     matter), or each LiDAR's local map over a window from frame i on (map_terra.hpp), as
+//     CalibrateOptions::tuning.terra_source.source says. automatic runs the frame search first and
+//     keeps it unless the sequences hold at least terra_maps_min_frames frames per LiDAR in the
+//     window AND the frame search failed or overlaps in fewer than terra_maps_below_mask cells;
+//     then the map search runs and wins when it succeeds with a larger mask. stages.terra says
+//     which
+//     ("source") and why. JEEP pairs frames by timestamp from frame i of each on and uses the first
+//     JeepOptions::frames pairs. Frames before i are never touched.
+//   - Stages: any ordered subset of terra, jeep, hots (stages.hpp); the default is all three
+//     (docs/design.md). TERRA needs no prior and ignores `initial`; each later stage starts from
+//     the previous stage's extrinsic, or from `initial` when it is the first, which is then
+//     required (status initial_required without it).
+//   - HOTS: multi-LiDAR odometry (options.tuning.odometry) over ALL frames of each LiDAR from frame
+//   i
+//     on, with the extrinsic HOTS starts from, then hots::refine (options.tuning.hots) on those
+//     frames and poses. Its extrinsic, clock offset and covariance become the result's. An odometry
+//     that could not register some frames still feeds HOTS (its poses are predictions there;
+//     the report counts them); an odometry that gives no poses, or a HOTS that fails, ends the
+//     call with hots_failed, keeping the previous extrinsic. With fewer than
+//     hots_min_frames frames per LiDAR (single frames, as in a static rig's snapshot) HOTS is
+//     skipped after TERRA or JEEP: stages.hots has status "skipped" and the reason. A HOTS
+//     whose clock offset the drive does not pin down fails too (time_offset_untrusted: the
+//     extrinsic would carry the offset's error times the speed); a caller who knows the
+//     clocks' offset sets time_offset_s, and then no offset is estimated or checked.
+//   - TERRA's hypotheses and HOTS as the judge (not in the paper): with HOTS on a moving rig,
+//     a JEEP that was rejected or did not settle hands its extrinsic to HOTS (hots_judges_jeep),
+//     and when the attempt from TERRA's best rotation fails in a way that points at the
+//     rotation (JEEP failed, or HOTS's extrinsic_unconfirmed), TERRA's next distinct optima run
+//     in turn (terra_hypotheses); the first success wins. When all of those fail, up to
+//     terra_fallback_hypotheses more (the kept search's other optima, then those of the search
+//     not kept) run, each needing JEEP's own acceptance before HOTS. With none, the best one's
+//     failure is reported. stages.terra.hypotheses lists each one tried and its outcome; timings
+//     sum over all of them.
+//   - Progress: options.progress(stage, fraction in [0, 1]) on the calling thread; stages
+//     "terra", "jeep", "odometry", "hots" (HOTS reports only 0 and 1); a later hypothesis's
+//     stages carry " (hypothesis k)".
+//   - Threads: every stage is deterministic for any thread count, so is this.
+//     CalibrateOptions::threads runs the call in a tbb::task_arena of that size.
+//   - Nothing here throws, exits or prints; it compiles with -fno-exceptions.
+#pragma once
+
+#include <chrono>
+#include <cmath>
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <tbb/task_arena.h>
+
+#include "pipeline/attempt.hpp"
+#include "pipeline/options.hpp"
+#include "pipeline/pair_calibration.hpp"
+#include "pipeline/stages.hpp"
+#include "pipeline/terra_stage.hpp"
+#include "ulc/core/frame_range.hpp"
+#include "ulc/core/types.hpp"
+
+namespace ulc {
+
+namespace calibrate_detail {
+
+/// Ends a call: status, reason and the total time into the result.
+struct Finish {
+  PairCalibration& result;
+  std::chrono::steady_clock::time_point start;
+  PairCalibration operator()(CalibrateStatus status, std::string reason) const {
+    result.status = status;
+    result.success = status == CalibrateStatus::ok;
+    result.reason = std::move(reason);
+    result.timing_s.total = seconds_since(start);
+    return result;
+  }
+};
+
+/// Why the inputs cannot be calibrated (an empty reason when they can).
+struct InputCheck {
+  CalibrateStatus status = CalibrateStatus::ok;
+  std::string reason;
+};
+
+template <class FramesA, class FramesB>
+InputCheck check_inputs(const FramesA& frames_a, const std::vector<double>& times_a,
+                        const FramesB& frames_b, const std::vector<double>& times_b,
+                        const CalibrateOptions& options) {
+  if (std::string why = check_stages(options.stages); !why.empty())
+    return {CalibrateStatus::invalid_input, "stages: " + why};
+  if (frames_a.size() != times_a.size() || frames_b.size() != times_b.size())
+    return {CalibrateStatus::invalid_input, "frame and timestamp counts differ"};
+  if (options.time_offset_s && !std::isfinite(*options.time_offset_s))
+    return {CalibrateStatus::invalid_input, "the known time offset is not finite"};
+  const std::size_t i = options.frame_index;
+  if (i >= frames_a.size() || i >= frames_b.size())
+    return {CalibrateStatus::invalid_input,
+            "frame_index " + std::to_string(i) + " is past the end (base has " +
+                std::to_string(frames_a.size()) + " frames, target " +
+                std::to_string(frames_b.size()) + ")"};
+  if (has_stage(options.stages, Stage::terra)) return {};
+  if (!options.initial)
+    return {CalibrateStatus::initial_required,
+            "stages without terra need an initial extrinsic (TERRA is what finds one without a "
+            "guess)"};
+  if (!options.initial->matrix().allFinite())
+    return {CalibrateStatus::invalid_input, "the initial extrinsic is not finite"};
+  return {};
+}
+
+/// A known clock offset: b's timestamps on a's clock, once, for every stage.
+inline std::vector<double> on_base_clock(std::vector<double> times_b,
+                                         const std::optional<double>& offset) {
+  if (offset)
+    for (double& t : times_b) t += *offset;
+  return times_b;
+}
+
+/// HOTS's options with a known clock offset applied: nothing to estimate or check.
+inline hots::RefineOptions hots_options(const CalibrateOptions& options) {
+  hots::RefineOptions o = options.tuning.hots;
+  if (options.time_offset_s) {
+    o.synchronise_time = false;
+    o.time_offset_s = 0.0;
+    o.sequence.estimate_time_offset = false;
+  }
+  return o;
+}
+
+inline TerraHypothesis hypothesis_entry(const terra::RotationCandidate& c, TerraSource source) {
+  TerraHypothesis h;
+  h.source = source;
+  h.rotation = c.rotation;
+  h.distance = c.distance;
+  h.mask_count = c.mask_count;
+  return h;
+}
+
+inline void add_timings(StageTimings& into, const StageTimings& t) {
+  into.jeep += t.jeep;
+  into.odometry += t.odometry;
+  into.hots += t.hots;
+}
+
+/// The stages' reports and outputs of one attempt into the result (timings are summed apart).
+inline void take_stages(PairCalibration& r, const PairCalibration& attempt) {
+  r.jeep = attempt.jeep;
+  r.hots = attempt.hots;
+  r.T_base_target = attempt.T_base_target;
+  r.time_offset_s = attempt.time_offset_s;
+  r.covariance_6x6 = attempt.covariance_6x6;
+}
+
+/// The TERRA stage into r.terra; the rotations to start from, or none when TERRA failed.
+template <class FA, class FB>
+std::optional<StartRotations> terra_step(const FA& frames_a, const std::vector<double>& times_a,
+                                         const FB& frames_b, const std::vector<double>& times_b,
+                                         const CalibrateOptions& options, PairCalibration& r) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const TerraInputs<FA, FB> in(frames_a, times_a, frames_b, times_b, options);
+  TerraReport report;
+  const TerraSearches searches = run_terra_search(in, report);
+  report.seconds = seconds_since(t0);
+  notify(options, "terra", 1.0);  // the map search may not have run after the frames' share
+  r.timing_s.terra = report.seconds;
+  r.terra = std::move(report);
+  if (!searches.kept.ok()) return std::nullopt;
+  return start_rotations(searches, r.terra->source, options.tuning.hypotheses);
+}
+
+/// TERRA's hypotheses in turn (terra_hypotheses.hpp): when what followed one points at its
+/// rotation (JEEP failed, or HOTS's cross links disagree) and HOTS can judge the next, the next
+/// runs. The first success wins; with none, the best hypothesis's outcome is the answer.
+template <class FA, class FB>
+PairCalibration try_hypotheses(const AttemptInputs<FA, FB>& in, const StartRotations& starts,
+                               PairCalibration& r, const Finish& finish) {
+  PairCalibration first;
+  StageOutcome first_outcome;
+  for (std::size_t k = 0; k < starts.candidates.size(); ++k) {
+    const auto t0 = std::chrono::steady_clock::now();
+    Isometry3d start = Isometry3d::Identity();
+    start.linear() = starts.candidates[k].rotation;
+    PairCalibration attempt;
+    attempt.time_offset_s = r.time_offset_s;
+    const std::string label = k == 0 ? "" : " (hypothesis " + std::to_string(k + 1) + ")";
+    const StageOutcome o = run_attempt(in, start, label, k < starts.first_fallback, attempt);
+    TerraHypothesis entry = hypothesis_entry(starts.candidates[k], starts.sources[k]);
+    entry.status = o.status;
+    entry.reason = o.reason;
+    entry.seconds = seconds_since(t0);
+    r.terra->hypotheses.push_back(entry);
+    add_timings(r.timing_s, attempt.timing_s);
+    // A failure that does not point at the rotation (the views confirmed it, the clocks'
+    // offset is untrusted, say) is this hypothesis's own answer; so is the best's when no other
+    // can be judged.
+    const bool next_worth_it =
+        in.can_verify() && o.points_at_start && k + 1 < starts.candidates.size();
+    if (o.status == CalibrateStatus::ok || (!next_worth_it && (k == 0 || !o.points_at_start))) {
+      take_stages(r, attempt);
+      r.terra->hypothesis_used = k;
+      return finish(o.status, o.reason);
+    }
+    if (k == 0) {
+      first = std::move(attempt);
+      first_outcome = o;
+    }
+  }
+  take_stages(r, first);
+  r.terra->hypothesis_used = 0;
+  return finish(first_outcome.status,
+                first_outcome.reason + "; TERRA's next " +
+                    std::to_string(r.terra->hypotheses.size() - 1) +
+                    " hypotheses were not confirmed either (stages.terra.hypotheses)");
+}
+
+/// TERRA alone: its best rotation is the answer.
+inline PairCalibration terra_only(const StartRotations& starts, PairCalibration& r,
+                                  const Finish& finish) {
+  r.T_base_target.linear() = starts.candidates.front().rotation;
+  r.terra->hypotheses.push_back(
+      hypothesis_entry(starts.candidates.front(), starts.sources.front()));
+  return finish(CalibrateStatus::ok, "");
+}
+
+/// The pipeline on validated inputs (calibrate_pair_in_place).
+template <class FA, class FB>
+PairCalibration run_pipeline(const FA& frames_a, const std::vector<double>& times_a,
+                             const FB& frames_b, const std::vector<double>& times_b_own,
+                             const CalibrateOptions& options, PairCalibration& r,
+                             const Finish& finish) {
+  const std::vector<double> times_b = on_base_clock(times_b_own, options.time_offset_s);
+  r.time_offset_s = options.time_offset_s.value_or(0.0);
+  const std::size_t i = options.frame_index;
+  const AttemptInputs<FA, FB> in{{FrameRange<FA>(frames_a, i), times_from(times_a, i), {}},
+                                 {FrameRange<FB>(frames_b, i), times_from(times_b, i), {}},
+                                 options,
+                                 hots_options(options),
+                                 has_stage(options.stages, Stage::terra),
+                                 has_stage(options.stages, Stage::jeep),
+                                 has_stage(options.stages, Stage::hots)};
+  if (!in.run_terra) {
+    r.T_base_target = *options.initial;
+    const StageOutcome o = run_attempt(in, *options.initial, "", true, r);
+    return finish(o.status, o.reason);
+  }
+  const auto starts = terra_step(frames_a, times_a, frames_b, times_b, options, r);
+  if (!starts)
+    return finish(CalibrateStatus::terra_failed,
+                  std::string("TERRA: ") + terra::to_string(r.terra->status) + ": " +
+                      r.terra->reason + " (on " + to_string(r.terra->source) + ")");
+  if (!in.run_jeep && !in.run_hots) return terra_only(*starts, r, finish);
+  return try_hypotheses(in, *starts, r, finish);
+}
+
+}  // namespace calibrate_detail
+
+/// Calibrates target LiDAR b against base LiDAR a (see the conventions at the top), reading the
+/// frames in place through the point traits: every stage is instantiated for FramesA and
+/// FramesB. ulc::calibrate_pair (pipeline/calibrate.hpp) runs this once, on PointCloud<float>.
+template <class FramesA, class FramesB>
+PairCalibration calibrate_pair_in_place(const FramesA& frames_a, const std::vector<double>& times_a,
+                                        const FramesB& frames_b, const std::vector<double>& times_b,
+                                        const CalibrateOptions& options = {}) {
+  PairCalibration r;
+  r.stages = options.stages;
+  const calibrate_detail::Finish finish{r, std::chrono::steady_clock::now()};
+  const calibrate_detail::InputCheck check =
+      calibrate_detail::check_inputs(frames_a, times_a, frames_b, times_b, options);
+  if (!check.reason.empty()) return finish(check.status, check.reason);
+  auto run = [&] {
+    return calibrate_detail::run_pipeline(frames_a, times_a, frames_b, times_b, options, r, finish);
+  };
+  if (options.threads == 0) return run();
+  tbb::task_arena arena(static_cast<int>(options.threads));
+  return arena.execute(run);
+}
+
+}  // namespace ulc
