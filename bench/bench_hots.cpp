@@ -308,7 +308,7 @@ Run one_run(const std::string& scenario, double offset_s, std::size_t run, const
         odometry::run_odometry(a.frames, a.timestamps, b.frames, times_b, C, o.tuning.odometry);
     out.odometry_s = seconds_since(t0);
     if (!ulc::calibrate_detail::odometry_usable(odo)) {
-      out.status = std::string("odometry_") + jeep::to_string(odo.status);
+      out.status = std::string("odometry_") + odometry::to_string(odo.status);
       return;
     }
     out.ate_odometry = ate(d, 0, odo.poses_a);

@@ -457,7 +457,7 @@ void frames_sweep(Config c) {
 // ---------------------------------------------------------------------------------------------
 // (c) odometry
 
-void odometry(Config c) {
+void odometry_bench(Config c) {
   if (c.scenarios.empty()) c.scenarios = {"64-32"};
   ulc_bench::Table table({"scenario", "mode", "threads", "pairs", "path_m", "end_drift_pct",
                           "segment_drift_pct", "rotation_drift_deg_per_100m", "pairs_per_s"});
@@ -650,7 +650,7 @@ int main(int argc, char** argv) {
     frames_sweep(c);
   } else if (c.mode == "odometry") {
     if (!repeats_given) c.bench.repeats = 1;  // a whole drive per repeat
-    odometry(c);
+    odometry_bench(c);
   } else {
     registration(c);
   }

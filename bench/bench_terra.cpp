@@ -470,7 +470,7 @@ struct MapsOptions {
   std::uint64_t seed = 1;
   unsigned decimation = 1;
   int threads = 2;
-  std::size_t below_mask = ulc::CalibrateOptions().terra_maps_below_mask;
+  std::size_t below_mask = ulc::CalibrateOptions().tuning.terra_source.maps_below_mask;
 };
 
 /// One start: the window's frames of each LiDAR from the start on (target turned by Q).
@@ -614,7 +614,9 @@ int run_maps(const ulc_bench::Options& options, const MapsOptions& mo) {
                     << (r.terra && r.terra->frames_mask_count
                             ? std::to_string(*r.terra->frames_mask_count)
                             : std::string("-"))
-                    << ", source " << (r.terra ? r.terra->source : std::string("-")) << ", map pts "
+                    << ", source "
+                    << (r.terra ? std::string(ulc::to_string(r.terra->source)) : std::string("-"))
+                    << ", map pts "
                     << (r.terra && r.terra->base_map ? r.terra->base_map->points : 0) << "/"
                     << (r.terra && r.terra->target_map ? r.terra->target_map->points : 0)
                     << ", odo "
