@@ -19,12 +19,13 @@
 //     term with post = T_world_anchor^-1 T_a(t_j + dt) around the estimated C (left
 //     perturbation, point_to_plane.hpp).
 //   - C and dt are solved together by Gauss-Newton on the 7 parameters [rho; phi; dt]
-//     (robust IRLS weights, matches refreshed every iteration, stages coarse to fine as in
-//     point_to_plane.hpp). The residual's dt column is n . (d post / d dt) y, y = C x, with
-//     d post / d dt by a central difference of the interpolated trajectory (derivative_step_s).
-//     Steps are taken in the Jacobi-scaled eigenbasis of the 7x7 normal matrix, skipping
-//     directions below min_condition: a straight, constant-speed drive cannot tell a clock
-//     offset from a translation along the road, and then dt does not move.
+//     (gauss_newton.hpp's loop with SequenceProblem as its residual: robust IRLS weights,
+//     matches refreshed every iteration, stages coarse to fine as in point_to_plane.hpp). The
+//     residual's dt column is n . (d post / d dt) y, y = C x, with d post / d dt by a central
+//     difference of the interpolated trajectory (derivative_step_s). Steps are taken in the
+//     Jacobi-scaled eigenbasis of the 7x7 normal matrix, skipping directions below min_condition: a
+//     straight, constant-speed drive cannot tell a clock offset from a translation along the road,
+//     and then dt does not move.
 //   - dt is adopted only when the data pin it down: its standard deviation (cluster-robust
 //     sandwich over blocks of time_cluster_frames target frames, see time_sigma) must be
 //     below max_time_sigma_s and the
@@ -65,6 +66,7 @@
 #include "hots/options.hpp"
 #include "hots/refine_statistics.hpp"
 #include "hots/time_sync.hpp"
+#include "ulc/core/gauss_newton.hpp"
 #include "ulc/core/point_to_plane.hpp"
 #include "ulc/core/registration_target.hpp"
 #include "ulc/core/voxel_downsample.hpp"
@@ -226,6 +228,320 @@ inline double time_observability(const Mat7& H) {
 
 }  // namespace sequence_detail
 
+namespace sequence_detail {
+
+/// The whole-sequence residual as gauss_newton.hpp's policy, over b's thinned frames `used`
+/// (of which `span` is solved for). State: C and dt; with_time false keeps dt (6 parameters).
+template <typename S>
+class SequenceProblem {
+ public:
+  struct State {
+    Isometry3d C = Isometry3d::Identity();
+    double dt = 0.0;
+  };
+  using Term = ulc::PointToPlaneTerm<S, Target<S>>;
+
+  SequenceProblem(const BaseSubmaps<S>& submaps, const std::vector<double>& times_a,
+                  const std::vector<Isometry3d>& world_a, const std::vector<double>& times_b,
+                  std::vector<std::size_t> used, std::vector<std::vector<ulc::Vec3<S>>> sources,
+                  double dt0, const SequenceExtrinsicOptions& o)
+      : submaps_(submaps),
+        times_a_(times_a),
+        world_a_(world_a),
+        times_b_(times_b),
+        used_(std::move(used)),
+        sources_(std::move(sources)),
+        dt0_(dt0),
+        o_(o),
+        span_{0, used_.size()} {
+    for (const std::size_t a : submaps.anchor) anchor_inverse_.push_back(world_a[a].inverse());
+  }
+
+  /// Solve with this stage's gate, kernel and tolerances; 7 parameters or C alone.
+  void set_stage(const ulc::RegistrationOptions& stage, bool with_time) {
+    stage_ = &stage;
+    with_time_ = with_time;
+  }
+  /// The frames of `used` solved for: [first, last).
+  void set_span(std::size_t first, std::size_t last) { span_ = {first, last}; }
+  std::size_t frame_count() const { return used_.size(); }
+  const std::vector<Term>& terms() const { return terms_; }
+
+  std::size_t match(const State& x) {
+    place(x.dt, true);
+    return ulc::match_point_to_plane(terms_, x.C, stage_->max_correspondence_distance, matches_);
+  }
+
+  bool step(State& x) {
+    const JointSums s = sums(x.C);
+    const Vec7 delta = truncated_step(s, with_time_ ? 7 : 6, o_.min_condition);
+    State next;
+    next.C = ulc::se3_exp(ulc::Vec6d(delta.head<6>())) * x.C;
+    next.dt =
+        std::clamp(x.dt + delta(6), dt0_ - 2.0 * o_.time_window_s, dt0_ + 2.0 * o_.time_window_s);
+    const bool small = moved_little_in_c(x.C, next.C) && std::abs(delta(6)) < 1e-6;
+    x = next;
+    if (with_time_) place(x.dt, false);
+    return small;
+  }
+
+  bool moved_little(const State& from, const State& to) const {
+    return moved_little_in_c(from.C, to.C) && std::abs(to.dt - from.dt) < 1e-6;
+  }
+
+  /// The sums at x with fresh matches (stage's gate): the solve's final statistics.
+  JointSums final_sums(const State& x) {
+    match(x);
+    return sums(x.C);
+  }
+
+ private:
+  bool moved_little_in_c(const Isometry3d& from, const Isometry3d& to) const {
+    return (to.translation() - from.translation()).norm() < stage_->translation_tolerance &&
+           ulc::so3_log(to.linear() * from.linear().transpose()).norm() <
+               stage_->rotation_tolerance;
+  }
+
+  /// Terms at dt; the submaps are chosen afresh only when choose_submaps.
+  void place(double dt, bool choose_submaps) {
+    if (choose_submaps) choose(dt);
+    dposts_.resize(terms_.size());
+    for (std::size_t i = 0; i < terms_.size(); ++i) {
+      const double t = times_b_[used_[term_frame_[i]]] + dt;
+      std::tie(terms_[i].post, dposts_[i]) =
+          placement(times_a_, world_a_, anchor_inverse_[term_submap_[i]], t, o_.derivative_step_s);
+    }
+  }
+
+  /// One term per frame of the span whose instant t_j + dt falls in a's span: its points
+  /// against the submap that holds that instant.
+  void choose(double dt) {
+    terms_.clear();
+    term_frame_.clear();
+    term_submap_.clear();
+    for (std::size_t k = span_.first; k < span_.second; ++k) {
+      const double t = times_b_[used_[k]] + dt;
+      if (t < times_a_.front() || t > times_a_.back() || sources_[k].empty()) continue;
+      const std::size_t m = submaps_.at(t);
+      if (submaps_.planes[m].empty()) continue;
+      Term term;
+      term.points = sources_[k].data();
+      term.size = sources_[k].size();
+      term.target = &submaps_.planes[m];
+      terms_.push_back(term);
+      term_frame_.push_back(k);
+      term_submap_.push_back(m);
+    }
+  }
+
+  /// The normal equations at C on the current matches, per term (for time_sigma) and summed.
+  JointSums sums(const Isometry3d& C) const {
+    JointSums total;
+    for (std::size_t i = 0; i < terms_.size(); ++i) {
+      if (matches_[i].size() != terms_[i].size) continue;
+      const JointSums term_sums = term_sums_at(i, C);
+      total += term_sums;
+      total.term_g.push_back(term_sums.g);
+    }
+    return total;
+  }
+
+  JointSums term_sums_at(std::size_t i, const Isometry3d& C) const {
+    const Term& term = terms_[i];
+    const auto& planes = matches_[i];
+    const ulc::RegistrationOptions& stage = *stage_;
+    const auto body = [&](std::size_t begin, std::size_t end, JointSums acc) {
+      Vec7 J;
+      for (std::size_t p = begin; p < end; ++p) {
+        if (planes[p].normal.squaredNorm() == 0.0) continue;
+        const double r = joint_residual(term.points[p].template cast<double>(), C, term.post,
+                                        dposts_[i], planes[p], J);
+        const double w = stage.kernel.weight(r);
+        acc.H.noalias() += w * J * J.transpose();
+        acc.g.noalias() += (w * r) * J;
+        acc.cost += stage.kernel.rho(r);
+        ++acc.count;
+        if (std::abs(r) <= stage.inlier_distance) {
+          ++acc.inliers;
+          acc.inlier_sq += r * r;
+        }
+      }
+      return acc;
+    };
+    const auto join = [](JointSums a, const JointSums& b) {
+      a += b;
+      return a;
+    };
+    return ulc::deterministic_reduce(term.size, JointSums{}, body, join, stage.grain);
+  }
+
+  const BaseSubmaps<S>& submaps_;
+  const std::vector<double>& times_a_;
+  const std::vector<Isometry3d>& world_a_;
+  const std::vector<double>& times_b_;
+  std::vector<Isometry3d> anchor_inverse_;
+  std::vector<std::size_t> used_;                   ///< b's frames taken (frame_stride)
+  std::vector<std::vector<ulc::Vec3<S>>> sources_;  ///< their thinned points
+  double dt0_;
+  const SequenceExtrinsicOptions& o_;
+  std::pair<std::size_t, std::size_t> span_;
+  const ulc::RegistrationOptions* stage_ = nullptr;
+  bool with_time_ = true;
+  std::vector<Term> terms_;
+  std::vector<std::size_t> term_frame_, term_submap_;  ///< per term: index into used_, submap
+  std::vector<Mat34> dposts_;
+  ulc::PointToPlaneMatches matches_;
+};
+
+/// Every frame_stride-th frame of b, thinned at source_voxel once: their placement depends on
+/// dt only.
+template <typename S>
+SequenceProblem<S> sequence_problem(const BaseSubmaps<S>& submaps,
+                                    const std::vector<double>& times_a,
+                                    const std::vector<Isometry3d>& world_a,
+                                    const std::vector<std::vector<ulc::Vec3<S>>>& frames_b,
+                                    const std::vector<double>& times_b, double dt0,
+                                    const SequenceExtrinsicOptions& o) {
+  std::vector<std::size_t> used;
+  for (std::size_t j = 0; j < frames_b.size(); j += std::max<std::size_t>(o.frame_stride, 1))
+    used.push_back(j);
+  std::vector<std::vector<ulc::Vec3<S>>> sources(used.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, used.size(), 1),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t k = r.begin(); k != r.end(); ++k) {
+                        const auto& f = frames_b[used[k]];
+                        auto down = ulc::voxel_downsample(f, o.source_voxel);
+                        sources[k] = down.ok() && o.source_voxel > 0.0 ? down.cloud.points : f;
+                      }
+                    });
+  return SequenceProblem<S>(submaps, times_a, world_a, times_b, std::move(used), std::move(sources),
+                            dt0, o);
+}
+
+/// One solve over the stages (fine_only: the last stage alone, for a start already at a
+/// solution), with its final sums at fresh matches.
+struct Solve {
+  bool ok = false;
+  const char* reason = "";
+  Isometry3d C = Isometry3d::Identity();
+  double dt = 0.0;
+  JointSums sums;
+};
+
+template <typename S>
+Solve solve(SequenceProblem<S>& problem, const Isometry3d& C, double dt, bool with_time,
+            const SequenceExtrinsicOptions& o, int& iterations, bool fine_only = false) {
+  constexpr const char* kStarved =
+      "too few correspondences between the target frames and the base's submaps";
+  Solve out;
+  typename SequenceProblem<S>::State x{C, dt};
+  for (std::size_t st = fine_only ? o.stages.size() - 1 : 0; st < o.stages.size(); ++st) {
+    const auto& stage = o.stages[st];
+    problem.set_stage(stage, with_time);
+    const ulc::GaussNewtonRun run = ulc::gauss_newton(
+        problem, x, {stage.max_iterations, stage.max_solver_iterations, stage.min_correspondences});
+    iterations += run.iterations;
+    if (run.starved) {
+      out.reason = kStarved;
+      return out;
+    }
+  }
+  problem.set_stage(o.stages.back(), with_time);
+  out.sums = problem.final_sums(x);
+  if (out.sums.count < o.stages.back().min_correspondences) {
+    out.reason = kStarved;
+    return out;
+  }
+  out.ok = true;
+  out.C = x.C;
+  out.dt = x.dt;
+  return out;
+}
+
+/// Why the whole-sequence step cannot run; nullptr when it can.
+template <typename S>
+const char* input_problem(const std::vector<std::vector<ulc::Vec3<S>>>& frames_a,
+                          const std::vector<double>& times_a,
+                          const std::vector<Isometry3d>& world_a,
+                          const std::vector<std::vector<ulc::Vec3<S>>>& frames_b,
+                          const std::vector<double>& times_b, const Isometry3d& C0, double dt0,
+                          const SequenceExtrinsicOptions& o) {
+  if (times_a.size() < 2 || world_a.size() != times_a.size() || frames_a.size() != times_a.size() ||
+      frames_b.size() != times_b.size() || o.stages.empty() || !(o.source_voxel >= 0.0) ||
+      !(o.target_voxel >= 0.0) || !(o.time_window_s >= 0.0) || !(o.derivative_step_s > 0.0) ||
+      !(o.min_condition >= 0.0) || !(o.max_time_disagreement_s >= 0.0) ||
+      !(o.min_time_observability >= 0.0) || !C0.matrix().allFinite() || !std::isfinite(dt0))
+    return "bad inputs or options";
+  for (const auto& stage : o.stages)
+    if (stage.max_iterations < 1 || stage.max_solver_iterations < 1 ||
+        !(stage.max_correspondence_distance > 0.0) || stage.grain < 1)
+      return "bad registration stage";
+  return nullptr;
+}
+
+/// The joint solve's dt statistics, and whether dt is adopted.
+inline void judge_joint_offset(const Solve& s, double dt0, const SequenceExtrinsicOptions& o,
+                               SequenceExtrinsicResult& result) {
+  result.joint_time_offset_s = s.dt;
+  result.time_sigma_s = time_sigma(s.sums.H, s.sums.term_g, o.time_cluster_frames);
+  result.time_observability = time_observability(s.sums.H);
+  result.time_offset_refined = o.estimate_time_offset && result.time_sigma_s < o.max_time_sigma_s &&
+                               std::abs(s.dt - dt0) <= o.time_window_s;
+}
+
+/// The trust check of the offset (see the conventions): observability, the two halves'
+/// agreement, and the kept offset against the joint solve's. Fills time_offset_doubt.
+template <typename S>
+void check_offset(SequenceProblem<S>& problem, const Solve& s, double dt0,
+                  const SequenceExtrinsicOptions& o, SequenceExtrinsicResult& result) {
+  result.time_offset_checked = true;
+  const double kept = result.time_offset_refined ? s.dt : dt0;
+  if (result.time_observability < o.min_time_observability) {
+    result.time_offset_doubt =
+        "the drive does not pin the clock offset down: it is nearly interchangeable with a "
+        "translation along the road";
+  } else {
+    // Each half from the whole solve's answer (fine stage only); a half that cannot be
+    // registered on its own fails the check.
+    bool halves_ok = true;
+    const std::size_t n = problem.frame_count(), middle = n / 2;
+    for (int h = 0; h < 2; ++h) {
+      problem.set_span(h == 0 ? 0 : middle, h == 0 ? middle : n);
+      const Solve half = solve(problem, s.C, s.dt, true, o, result.iterations, true);
+      halves_ok = halves_ok && half.ok;
+      result.half_time_offset_s[h] = half.ok ? half.dt : s.dt;
+    }
+    problem.set_span(0, n);
+    if (!halves_ok)
+      result.time_offset_doubt = "a half of the drive could not be registered on its own";
+    else if (std::abs(result.half_time_offset_s[0] - result.half_time_offset_s[1]) >
+             o.max_time_disagreement_s)
+      result.time_offset_doubt = "the two halves of the drive give different clock offsets";
+    else if (std::abs(kept - s.dt) > o.max_time_disagreement_s)
+      result.time_offset_doubt =
+          "the registration of the whole drive points to a different clock offset than the "
+          "time synchronisation's";
+  }
+  result.time_offset_trusted = *result.time_offset_doubt == '\0';
+}
+
+/// The solve's answer and statistics into the result.
+template <typename S>
+void take_solve(const Solve& s, const SequenceProblem<S>& problem,
+                SequenceExtrinsicResult& result) {
+  result.status = SequenceExtrinsicStatus::ok;
+  result.extrinsic = s.C;
+  result.time_offset_s = s.dt;
+  result.frames = problem.terms().size();
+  for (const auto& t : problem.terms()) result.source_points += t.size;
+  result.correspondences = s.sums.count;
+  result.inliers = s.sums.inliers;
+  result.rmse = s.sums.rmse();
+  result.cost = s.sums.cost;
+}
+
+}  // namespace sequence_detail
+
 /// See the header comment. world_a: T_world_a after the pose graph; frames_b: b's prepared
 /// (deskewed, downsampled) frames in b's body frame at times_b.
 template <typename S>
@@ -248,223 +564,23 @@ SequenceExtrinsicResult sequence_extrinsic(const HierarchyResult<S>& ha,
     result.time_offset_s = dt0;
     return result;
   };
-  if (times_a.size() < 2 || world_a.size() != times_a.size() || frames_a.size() != times_a.size() ||
-      frames_b.size() != times_b.size() || o.stages.empty() || !(o.source_voxel >= 0.0) ||
-      !(o.target_voxel >= 0.0) || !(o.time_window_s >= 0.0) || !(o.derivative_step_s > 0.0) ||
-      !(o.min_condition >= 0.0) || !(o.max_time_disagreement_s >= 0.0) ||
-      !(o.min_time_observability >= 0.0) || !C0.matrix().allFinite() || !std::isfinite(dt0))
-    return fail(SequenceExtrinsicStatus::invalid_input, "bad inputs or options");
-  for (const auto& stage : o.stages)
-    if (stage.max_iterations < 1 || stage.max_solver_iterations < 1 ||
-        !(stage.max_correspondence_distance > 0.0) || stage.grain < 1)
-      return fail(SequenceExtrinsicStatus::invalid_input, "bad registration stage");
-
+  if (const char* why = d::input_problem(frames_a, times_a, world_a, frames_b, times_b, C0, dt0, o))
+    return fail(SequenceExtrinsicStatus::invalid_input, why);
   const d::BaseSubmaps<S> submaps = d::base_submaps(ha, frames_a, times_a, o);
   if (submaps.planes.empty()) return fail(SequenceExtrinsicStatus::invalid_input, "no submaps");
   result.targets = submaps.planes.size();
-  std::vector<Isometry3d> anchor_inverse;
-  for (const std::size_t a : submaps.anchor) anchor_inverse.push_back(world_a[a].inverse());
-
-  // Target frames thinned once; their placement depends on dt only.
-  std::vector<std::size_t> used;
-  for (std::size_t j = 0; j < frames_b.size(); j += std::max<std::size_t>(o.frame_stride, 1))
-    used.push_back(j);
-  std::vector<std::vector<ulc::Vec3<S>>> sources(used.size());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, used.size(), 1),
-                    [&](const tbb::blocked_range<std::size_t>& r) {
-                      for (std::size_t k = r.begin(); k != r.end(); ++k) {
-                        const auto& f = frames_b[used[k]];
-                        auto down = ulc::voxel_downsample(f, o.source_voxel);
-                        sources[k] = down.ok() && o.source_voxel > 0.0 ? down.cloud.points : f;
-                      }
-                    });
-
-  using Term = ulc::PointToPlaneTerm<S, d::Target<S>>;
-  std::vector<Term> terms;
-  std::vector<std::size_t> term_frame, term_submap;  // per term: index into used, submap
-  std::vector<d::Mat34> dposts;
-  std::pair<std::size_t, std::size_t> span{0, used.size()};  // the frames (of used) solved for
-  // Terms at dt; the submaps are chosen afresh only when choose_submaps.
-  auto place = [&](double dt, bool choose_submaps) {
-    if (choose_submaps) {
-      terms.clear();
-      term_frame.clear();
-      term_submap.clear();
-      for (std::size_t k = span.first; k < span.second; ++k) {
-        const double t = times_b[used[k]] + dt;
-        if (t < times_a.front() || t > times_a.back() || sources[k].empty()) continue;
-        const std::size_t m = submaps.at(t);
-        if (submaps.planes[m].empty()) continue;
-        Term term;
-        term.points = sources[k].data();
-        term.size = sources[k].size();
-        term.target = &submaps.planes[m];
-        terms.push_back(term);
-        term_frame.push_back(k);
-        term_submap.push_back(m);
-      }
-    }
-    dposts.resize(terms.size());
-    for (std::size_t i = 0; i < terms.size(); ++i) {
-      const double t = times_b[used[term_frame[i]]] + dt;
-      std::tie(terms[i].post, dposts[i]) =
-          d::placement(times_a, world_a, anchor_inverse[term_submap[i]], t, o.derivative_step_s);
-    }
-  };
-  auto sums_at = [&](const ulc::PointToPlaneMatches& matches, const Isometry3d& C,
-                     const ulc::RegistrationOptions& stage) {
-    d::JointSums total;
-    for (std::size_t i = 0; i < terms.size(); ++i) {
-      const Term& term = terms[i];
-      const auto& planes = matches[i];
-      if (planes.size() != term.size) continue;
-      const auto body = [&](std::size_t begin, std::size_t end, d::JointSums acc) {
-        d::Vec7 J;
-        for (std::size_t p = begin; p < end; ++p) {
-          if (planes[p].normal.squaredNorm() == 0.0) continue;
-          const double r = d::joint_residual(term.points[p].template cast<double>(), C, term.post,
-                                             dposts[i], planes[p], J);
-          const double w = stage.kernel.weight(r);
-          acc.H.noalias() += w * J * J.transpose();
-          acc.g.noalias() += (w * r) * J;
-          acc.cost += stage.kernel.rho(r);
-          ++acc.count;
-          if (std::abs(r) <= stage.inlier_distance) {
-            ++acc.inliers;
-            acc.inlier_sq += r * r;
-          }
-        }
-        return acc;
-      };
-      const auto join = [](d::JointSums a, const d::JointSums& b) {
-        a += b;
-        return a;
-      };
-      const d::JointSums term_sums =
-          ulc::deterministic_reduce(term.size, d::JointSums{}, body, join, stage.grain);
-      total += term_sums;
-      total.term_g.push_back(term_sums.g);
-    }
-    return total;
-  };
-
-  // Gauss-Newton over the stages; with_time: 7 parameters, else C alone.
-  struct Solve {
-    bool ok = false;
-    const char* reason = "";
-    Isometry3d C = Isometry3d::Identity();
-    double dt = 0.0;
-    d::JointSums sums;
-  };
-  // fine_only: the last stage alone (a start already at a solution).
-  auto solve = [&](Isometry3d C, double dt, bool with_time, bool fine_only = false) {
-    Solve out;
-    const int n = with_time ? 7 : 6;
-    ulc::PointToPlaneMatches matches;
-    for (std::size_t st = fine_only ? o.stages.size() - 1 : 0; st < o.stages.size(); ++st) {
-      const auto& stage = o.stages[st];
-      for (int it = 0; it < stage.max_iterations; ++it) {
-        place(dt, true);
-        const std::size_t found =
-            ulc::match_point_to_plane(terms, C, stage.max_correspondence_distance, matches);
-        ++result.iterations;
-        if (found < stage.min_correspondences) {
-          out.reason = "too few correspondences between the target frames and the base's submaps";
-          return out;
-        }
-        const Isometry3d C_matched = C;
-        const double dt_matched = dt;
-        for (int step = 0; step < stage.max_solver_iterations; ++step) {
-          const d::JointSums s = sums_at(matches, C, stage);
-          const d::Vec7 delta = d::truncated_step(s, n, o.min_condition);
-          const Isometry3d next = ulc::se3_exp(ulc::Vec6d(delta.head<6>())) * C;
-          const bool small =
-              (next.translation() - C.translation()).norm() < stage.translation_tolerance &&
-              ulc::so3_log(next.linear() * C.linear().transpose()).norm() <
-                  stage.rotation_tolerance &&
-              std::abs(delta(6)) < 1e-6;
-          C = next;
-          dt = std::clamp(dt + delta(6), dt0 - 2.0 * o.time_window_s, dt0 + 2.0 * o.time_window_s);
-          if (with_time) place(dt, false);
-          if (small) break;
-        }
-        if ((C.translation() - C_matched.translation()).norm() < stage.translation_tolerance &&
-            ulc::so3_log(C.linear() * C_matched.linear().transpose()).norm() <
-                stage.rotation_tolerance &&
-            std::abs(dt - dt_matched) < 1e-6)
-          break;
-      }
-    }
-    place(dt, true);
-    const auto& last = o.stages.back();
-    ulc::match_point_to_plane(terms, C, last.max_correspondence_distance, matches);
-    out.sums = sums_at(matches, C, last);
-    if (out.sums.count < last.min_correspondences) {
-      out.reason = "too few correspondences between the target frames and the base's submaps";
-      return out;
-    }
-    out.ok = true;
-    out.C = C;
-    out.dt = dt;
-    return out;
-  };
+  auto problem = d::sequence_problem(submaps, times_a, world_a, frames_b, times_b, dt0, o);
 
   const bool joint = o.estimate_time_offset || o.check_time_offset;
-  Solve s = solve(C0, dt0, joint);
+  d::Solve s = d::solve(problem, C0, dt0, joint, o, result.iterations);
   if (!s.ok) return fail(SequenceExtrinsicStatus::registration_failed, s.reason);
-  if (joint) {
-    result.joint_time_offset_s = s.dt;
-    result.time_sigma_s = d::time_sigma(s.sums.H, s.sums.term_g, o.time_cluster_frames);
-    result.time_observability = d::time_observability(s.sums.H);
-    result.time_offset_refined = o.estimate_time_offset &&
-                                 result.time_sigma_s < o.max_time_sigma_s &&
-                                 std::abs(s.dt - dt0) <= o.time_window_s;
-  }
-  if (o.check_time_offset) {
-    result.time_offset_checked = true;
-    const double kept = result.time_offset_refined ? s.dt : dt0;
-    if (result.time_observability < o.min_time_observability) {
-      result.time_offset_doubt =
-          "the drive does not pin the clock offset down: it is nearly interchangeable with a "
-          "translation along the road";
-    } else {
-      // Each half from the whole solve's answer (fine stage only); a half that cannot be
-      // registered on its own fails the check.
-      bool halves_ok = true;
-      const std::size_t middle = used.size() / 2;
-      for (int h = 0; h < 2; ++h) {
-        span.first = h == 0 ? 0 : middle;
-        span.second = h == 0 ? middle : used.size();
-        const Solve half = solve(s.C, s.dt, true, true);
-        halves_ok = halves_ok && half.ok;
-        result.half_time_offset_s[h] = half.ok ? half.dt : s.dt;
-      }
-      span = {0, used.size()};
-      if (!halves_ok)
-        result.time_offset_doubt = "a half of the drive could not be registered on its own";
-      else if (std::abs(result.half_time_offset_s[0] - result.half_time_offset_s[1]) >
-               o.max_time_disagreement_s)
-        result.time_offset_doubt = "the two halves of the drive give different clock offsets";
-      else if (std::abs(kept - s.dt) > o.max_time_disagreement_s)
-        result.time_offset_doubt =
-            "the registration of the whole drive points to a different clock offset than the "
-            "time synchronisation's";
-    }
-    result.time_offset_trusted = *result.time_offset_doubt == '\0';
-  }
+  if (joint) d::judge_joint_offset(s, dt0, o, result);
+  if (o.check_time_offset) d::check_offset(problem, s, dt0, o, result);
   if (joint && !result.time_offset_refined) {
-    s = solve(C0, dt0, false);
+    s = d::solve(problem, C0, dt0, false, o, result.iterations);
     if (!s.ok) return fail(SequenceExtrinsicStatus::registration_failed, s.reason);
   }
-  result.status = SequenceExtrinsicStatus::ok;
-  result.extrinsic = s.C;
-  result.time_offset_s = s.dt;
-  result.frames = terms.size();
-  for (const auto& t : terms) result.source_points += t.size;
-  result.correspondences = s.sums.count;
-  result.inliers = s.sums.inliers;
-  result.rmse = s.sums.rmse();
-  result.cost = s.sums.cost;
+  d::take_solve(s, problem, result);
   return result;
 }
 

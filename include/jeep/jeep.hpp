@@ -88,8 +88,198 @@ inline void pose_change(const Isometry3d& before, const Isometry3d& after, doubl
   rotation = std::max(rotation, ulc::so3_log(d.linear()).norm());
 }
 
+/// Why run_jeep cannot run; nullptr when it can.
+template <class FramesA, class FramesB>
+const char* input_problem(const FramesA& frames_a, const std::vector<double>& times_a,
+                          const FramesB& frames_b, const std::vector<double>& times_b,
+                          const Isometry3d& initial, const JeepOptions& options) {
+  if (options.frames < 1 || options.max_rounds < 1 ||
+      !odometry::valid_odometry_options(options.odometry) || options.calibration.stages.empty() ||
+      options.refine_stages < 1 || !(options.default_period > 0.0))
+    return "bad options";
+  if (frames_a.size() != times_a.size() || frames_b.size() != times_b.size())
+    return "frame and timestamp counts differ";
+  if (!odometry::timestamps_usable(times_a) || !odometry::timestamps_usable(times_b))
+    return "timestamps not finite and nondecreasing";
+  if (!initial.matrix().allFinite()) return "initial extrinsic not finite";
+  return nullptr;
+}
+
+/// The first K frame pairs, their timestamps (b's on a's clock) and the frame periods.
+struct JeepPairs {
+  std::vector<odometry::FramePair> pairs;
+  std::vector<double> t_a, t_b;
+  double period_a = 0.0, period_b = 0.0;
+  std::size_t size() const { return pairs.size(); }
+};
+
+inline JeepPairs jeep_pairs(const std::vector<double>& times_a, const std::vector<double>& times_b,
+                            const JeepOptions& options) {
+  const odometry::OdometryOptions& odo = options.odometry;
+  JeepPairs p;
+  p.period_a = odometry::frame_period(times_a);
+  p.period_b = odometry::frame_period(times_b);
+  if (!(p.period_a > 0.0)) p.period_a = options.default_period;
+  if (!(p.period_b > 0.0)) p.period_b = p.period_a;
+  p.pairs =
+      odometry::pair_frames(times_a, times_b, odo.time_offset_s, odo.max_pair_gap * p.period_a);
+  if (p.pairs.size() > options.frames) p.pairs.resize(options.frames);
+  for (const odometry::FramePair& pair : p.pairs) {
+    p.t_a.push_back(times_a[pair.a]);
+    p.t_b.push_back(times_b[pair.b] + odo.time_offset_s);
+  }
+  return p;
+}
+
+/// Motion bootstrap: a alone, undeskewed; its mid-sweep poses are unbiased by the missing
+/// deskew (odometry.hpp), so one pass gives the twists that deskew the first round.
+template <typename S, class FramesA>
+std::vector<Vec6d> bootstrap_twists(const FramesA& frames_a, const JeepPairs& p,
+                                    const odometry::OdometryOptions& odo) {
+  const std::size_t K = p.size();
+  std::vector<Vec6d> twists(K, Vec6d::Zero());
+  if (K < 2) return twists;
+  odometry::Odometry<S> single(odo);
+  std::vector<Isometry3d> mids;
+  std::vector<double> mid_times;
+  for (std::size_t k = 0; k < K; ++k) {
+    const auto scan =
+        odometry::prepare_scan<S>(frames_a[p.pairs[k].a], twists[k], p.period_a, odo.scan);
+    const odometry::OdometryStep step = single.step(scan, p.t_a[k], nullptr, p.t_a[k]);
+    mids.push_back(step.mid_pose_a);
+    mid_times.push_back(step.mid_time);
+  }
+  return odometry::twists_from_mid_poses(mids, mid_times);
+}
+
+/// One round's pose phase (eq:je_odom): both scans of each pair against their own maps, b
+/// through C, deskewed with the previous round's twists; it updates the twists.
+template <typename S>
+struct PosePhase {
+  odometry::Odometry<S> odometry;
+  std::vector<odometry::PreparedScan<S>> scans_a, scans_b;
+  std::vector<Isometry3d> poses_a;  ///< at a's timestamps
+  std::vector<Isometry3d> scan_poses_a, scan_poses_b;
+  std::size_t failed_steps = 0;
+};
+
+template <typename S, class FramesA, class FramesB>
+PosePhase<S> pose_phase(const FramesA& frames_a, const FramesB& frames_b, const JeepPairs& p,
+                        const Isometry3d& C, const std::vector<Isometry3d>& previous_poses,
+                        int round, const odometry::OdometryOptions& odo,
+                        std::vector<Vec6d>& twists) {
+  // After the first round the previous poses are close guesses: the fine stage alone.
+  odometry::OdometryOptions round_odo = odo;
+  round_odo.single_stage = odo.single_stage || round > 1;
+  const std::size_t K = p.size();
+  PosePhase<S> phase{odometry::Odometry<S>(round_odo, C), {}, {}, {}, {}, {}, 0};
+  std::vector<Isometry3d> mids(K);
+  std::vector<double> mid_times(K);
+  for (std::size_t k = 0; k < K; ++k) {
+    phase.scans_a.push_back(
+        odometry::prepare_scan<S>(frames_a[p.pairs[k].a], twists[k], p.period_a, odo.scan));
+    phase.scans_b.push_back(odometry::prepare_scan<S>(
+        frames_b[p.pairs[k].b], phase.odometry.target_twist(twists[k]), p.period_b, odo.scan));
+    phase.odometry.set_twist(twists[k]);
+    std::optional<Isometry3d> guess;
+    if (!previous_poses.empty()) guess = previous_poses[k];
+    const odometry::OdometryStep step =
+        phase.odometry.step(phase.scans_a[k], p.t_a[k], &phase.scans_b[k], p.t_b[k], guess);
+    if (k > 0 && !step.registered) ++phase.failed_steps;
+    mids[k] = step.mid_pose_a;
+    mid_times[k] = step.mid_time;
+    phase.scan_poses_a.push_back(step.scan_pose_a);
+    phase.scan_poses_b.push_back(step.scan_pose_b);
+  }
+  // Mid-sweep poses are unbiased by the deskew twists' errors; their central differences
+  // give the next round's twists, and the poses at the timestamps.
+  twists = odometry::twists_from_mid_poses(mids, mid_times, twists[0]);
+  for (std::size_t k = 0; k < K; ++k)
+    phase.poses_a.push_back(mids[k] * ulc::se3_exp(Vec6d((p.t_a[k] - mid_times[k]) * twists[k])));
+  return phase;
+}
+
+/// One round's calibration phase (eq:calib_map): map b onto map a from C; the first round
+/// searches a few starts around C (start_search.hpp), later ones run the fine stages alone.
+template <typename S>
+struct CalibrationPhase {
+  std::vector<Vec3<S>> map_a, map_b;
+  ulc::PlaneCloud<S> target;
+  MapRegistrationOptions stages;
+  RegistrationResult<double> registration;
+};
+
+template <typename S>
+CalibrationPhase<S> calibration_phase(const PosePhase<S>& phase, const Isometry3d& C, int round,
+                                      const JeepOptions& options, StartSearchReport* search) {
+  const std::size_t K = phase.scans_a.size();
+  std::vector<const std::vector<ulc::Vec3<S>>*> dense_a(K), dense_b(K);
+  for (std::size_t k = 0; k < K; ++k) {
+    dense_a[k] = &phase.scans_a[k].dense;
+    dense_b[k] = &phase.scans_b[k].dense;
+  }
+  CalibrationPhase<S> out;
+  out.map_a = assemble_map<S>(dense_a, phase.scan_poses_a);
+  out.map_b = assemble_map<S>(dense_b, phase.scan_poses_b);
+  out.target = map_target(out.map_a, options.calibration);
+  out.stages = options.calibration;
+  if (round > 1 && out.stages.stages.size() > options.refine_stages)
+    out.stages.stages.erase(
+        out.stages.stages.begin(),
+        out.stages.stages.end() - static_cast<std::ptrdiff_t>(options.refine_stages));
+  out.registration = round == 1 ? register_maps_searching(out.map_b, out.target, C, out.stages,
+                                                          options.start_search, search)
+                                : register_maps(out.map_b, out.target, C, out.stages);
+  return out;
+}
+
+/// The round's poses and twists as outputs, in a's frame at its first timestamp (internally:
+/// at its first mid-sweep).
+template <typename S>
+void output_poses(const PosePhase<S>& phase, const JeepPairs& p, const Isometry3d& C,
+                  const std::vector<Vec6d>& twists, JeepResult& result) {
+  const std::size_t K = p.size();
+  const Isometry3d to_first = phase.poses_a[0].inverse();
+  const Isometry3d to_first_b = C.inverse() * to_first * C;
+  result.poses_a.resize(K);
+  result.poses_b.resize(K);
+  for (std::size_t k = 0; k < K; ++k) {
+    result.poses_a[k] = to_first * phase.poses_a[k];
+    result.poses_b[k] =
+        to_first_b * phase.odometry.target_pose(phase.poses_a[k], p.t_a[k], p.t_b[k], twists[k]);
+  }
+  result.twists = twists;
+}
+
+/// Settled: C and every pose of a moved less than the settle thresholds this round (with one
+/// pair there are no poses to settle: C alone decides).
+inline bool settled(const JeepRound& trace, bool first_round, std::size_t K,
+                    const JeepOptions& options) {
+  const bool c_still = trace.change_translation < options.settle_translation &&
+                       trace.change_rotation < options.settle_rotation;
+  if (K == 1) return c_still;
+  return !first_round && c_still && trace.pose_change_translation < options.settle_translation &&
+         trace.pose_change_rotation < options.settle_rotation;
+}
+
+/// The last round's verdict: the acceptance rule (acceptance.hpp) on C, and the maps at
+/// calibration.target_voxel in the output poses' frames.
+template <typename S>
+void judge_last_round(const PosePhase<S>& phase, const CalibrationPhase<S>& cal,
+                      const Isometry3d& C, const JeepOptions& options, JeepResult& result) {
+  result.acceptance =
+      assess(cal.map_a, cal.map_b, cal.target, options.calibration, C, options.acceptance);
+  const Isometry3d to_first = phase.poses_a[0].inverse();
+  const Isometry3d to_first_b = C.inverse() * to_first * C;
+  for (const auto& p : downsampled(cal.map_a, options.calibration.target_voxel).points)
+    result.map_a.push_back(to_first * p.template cast<double>());
+  for (const auto& p : downsampled(cal.map_b, options.calibration.target_voxel).points)
+    result.map_b.push_back(to_first_b * p.template cast<double>());
+}
+
 }  // namespace detail
 
+/// See the header comment. progress(round, max_rounds) after each round.
 template <class FramesA, class FramesB>
 JeepResult run_jeep(const FramesA& frames_a, const std::vector<double>& times_a,
                     const FramesB& frames_b, const std::vector<double>& times_b,
@@ -103,155 +293,49 @@ JeepResult run_jeep(const FramesA& frames_a, const std::vector<double>& times_a,
     result.reason = why;
     return result;
   };
-  if (options.frames < 1 || options.max_rounds < 1 ||
-      !odometry::valid_odometry_options(options.odometry) || options.calibration.stages.empty() ||
-      options.refine_stages < 1 || !(options.default_period > 0.0))
-    return fail(JeepStatus::invalid_input, "bad options");
-  if (frames_a.size() != times_a.size() || frames_b.size() != times_b.size())
-    return fail(JeepStatus::invalid_input, "frame and timestamp counts differ");
-  if (!odometry::timestamps_usable(times_a) || !odometry::timestamps_usable(times_b))
-    return fail(JeepStatus::invalid_input, "timestamps not finite and nondecreasing");
-  if (!initial.matrix().allFinite())
-    return fail(JeepStatus::invalid_input, "initial extrinsic not finite");
-
-  const odometry::OdometryOptions& odo = options.odometry;
-  double period_a = odometry::frame_period(times_a), period_b = odometry::frame_period(times_b);
-  if (!(period_a > 0.0)) period_a = options.default_period;
-  if (!(period_b > 0.0)) period_b = period_a;
-  std::vector<odometry::FramePair> pairs =
-      odometry::pair_frames(times_a, times_b, odo.time_offset_s, odo.max_pair_gap * period_a);
-  if (pairs.empty()) return fail(JeepStatus::too_few_frames, "no frame of b near a frame of a");
-  if (pairs.size() > options.frames) pairs.resize(options.frames);
-  result.pairs = pairs;
-  const std::size_t K = pairs.size();
-  std::vector<double> t_a(K), t_b(K);
-  for (std::size_t k = 0; k < K; ++k) {
-    t_a[k] = times_a[pairs[k].a];
-    t_b[k] = times_b[pairs[k].b] + odo.time_offset_s;
-  }
-
-  // Motion bootstrap: a alone, undeskewed, then once more deskewed with what it found.
-  std::vector<Vec6d> twists(K, Vec6d::Zero());
-  // One pass suffices: mid-sweep poses are unbiased by the missing deskew (odometry.hpp).
-  for (int pass = 0; pass < 1 && K >= 2; ++pass) {
-    odometry::Odometry<S> single(odo);
-    std::vector<Isometry3d> mids;
-    std::vector<double> mid_times;
-    for (std::size_t k = 0; k < K; ++k) {
-      if (pass > 0) single.set_twist(twists[k]);
-      const auto scan =
-          odometry::prepare_scan<S>(frames_a[pairs[k].a], twists[k], period_a, odo.scan);
-      const odometry::OdometryStep step = single.step(scan, t_a[k], nullptr, t_a[k]);
-      mids.push_back(step.mid_pose_a);
-      mid_times.push_back(step.mid_time);
-    }
-    twists = odometry::twists_from_mid_poses(mids, mid_times);
-  }
+  if (const char* why =
+          detail::input_problem(frames_a, times_a, frames_b, times_b, initial, options))
+    return fail(JeepStatus::invalid_input, why);
+  const detail::JeepPairs p = detail::jeep_pairs(times_a, times_b, options);
+  if (p.pairs.empty()) return fail(JeepStatus::too_few_frames, "no frame of b near a frame of a");
+  result.pairs = p.pairs;
+  std::vector<Vec6d> twists = detail::bootstrap_twists<S>(frames_a, p, options.odometry);
 
   Isometry3d C = initial;
   std::vector<Isometry3d> previous_poses;
   bool settled = false;
   for (int round = 1; round <= options.max_rounds && !settled; ++round) {
-    // Pose phase (eq:je_odom). After the first round the previous poses are close guesses:
-    // the fine registration stage alone, and the calibration phase's fine stages alone.
-    odometry::OdometryOptions round_odo = odo;
-    round_odo.single_stage = odo.single_stage || round > 1;
-    odometry::Odometry<S> pose_phase(round_odo, C);
-    std::vector<odometry::PreparedScan<S>> scans_a(K), scans_b(K);
-    std::vector<Isometry3d> mids(K), poses_a(K), poses_b(K), scan_poses_a(K), scan_poses_b(K);
-    std::vector<double> mid_times(K);
+    const auto phase = detail::pose_phase<S>(frames_a, frames_b, p, C, previous_poses, round,
+                                             options.odometry, twists);
+    const auto cal = detail::calibration_phase(phase, C, round, options, &result.start_search);
     JeepRound trace;
-    for (std::size_t k = 0; k < K; ++k) {
-      scans_a[k] = odometry::prepare_scan<S>(frames_a[pairs[k].a], twists[k], period_a, odo.scan);
-      scans_b[k] = odometry::prepare_scan<S>(
-          frames_b[pairs[k].b], pose_phase.target_twist(twists[k]), period_b, odo.scan);
-      pose_phase.set_twist(twists[k]);
-      std::optional<Isometry3d> guess;
-      if (!previous_poses.empty()) guess = previous_poses[k];
-      const odometry::OdometryStep step =
-          pose_phase.step(scans_a[k], t_a[k], &scans_b[k], t_b[k], guess);
-      if (k > 0 && !step.registered) ++trace.failed_steps;
-      mids[k] = step.mid_pose_a;
-      mid_times[k] = step.mid_time;
-      scan_poses_a[k] = step.scan_pose_a;
-      scan_poses_b[k] = step.scan_pose_b;
-    }
-    // Mid-sweep poses are unbiased by the deskew twists' errors; their central differences
-    // give the next round's twists, and the poses at the timestamps.
-    twists = odometry::twists_from_mid_poses(mids, mid_times, twists[0]);
-    for (std::size_t k = 0; k < K; ++k) {
-      poses_a[k] = mids[k] * ulc::se3_exp(Vec6d((t_a[k] - mid_times[k]) * twists[k]));
-      poses_b[k] = pose_phase.target_pose(poses_a[k], t_a[k], t_b[k], twists[k]);
-    }
-
-    // Calibration phase (eq:calib_map): map b onto map a.
-    std::vector<const std::vector<ulc::Vec3<S>>*> dense_a(K), dense_b(K);
-    for (std::size_t k = 0; k < K; ++k) {
-      dense_a[k] = &scans_a[k].dense;
-      dense_b[k] = &scans_b[k].dense;
-    }
-    const auto map_a = assemble_map<S>(dense_a, scan_poses_a);
-    const auto map_b = assemble_map<S>(dense_b, scan_poses_b);
-    const auto target = map_target(map_a, options.calibration);
-    MapRegistrationOptions stages = options.calibration;
-    if (round > 1 && stages.stages.size() > options.refine_stages)
-      stages.stages.erase(stages.stages.begin(),
-                          stages.stages.end() - static_cast<std::ptrdiff_t>(options.refine_stages));
-    const auto calibration =
-        round == 1 ? register_maps_searching(map_b, target, C, stages, options.start_search,
-                                             &result.start_search)
-                   : register_maps(map_b, target, C, stages);
-    trace.calibration_status = calibration.status;
-
-    detail::pose_change(C, calibration.pose, trace.change_translation, trace.change_rotation);
-    for (std::size_t k = 0; k < K && !previous_poses.empty(); ++k)
-      detail::pose_change(previous_poses[k], poses_a[k], trace.pose_change_translation,
+    trace.failed_steps = phase.failed_steps;
+    trace.calibration_status = cal.registration.status;
+    detail::pose_change(C, cal.registration.pose, trace.change_translation, trace.change_rotation);
+    for (std::size_t k = 0; k < p.size() && !previous_poses.empty(); ++k)
+      detail::pose_change(previous_poses[k], phase.poses_a[k], trace.pose_change_translation,
                           trace.pose_change_rotation);
-    const bool usable = calibration.status != ulc::RegistrationStatus::too_few_correspondences &&
-                        calibration.status != ulc::RegistrationStatus::invalid_input;
-    if (usable) C = calibration.pose;
+    const bool usable =
+        cal.registration.status != ulc::RegistrationStatus::too_few_correspondences &&
+        cal.registration.status != ulc::RegistrationStatus::invalid_input;
+    if (usable) C = cal.registration.pose;
     trace.extrinsic = C;
     result.trace.push_back(trace);
     result.rounds = round;
     result.extrinsic = C;
-    // Outputs in a's frame at its first timestamp (internally: at its first mid-sweep).
-    const Isometry3d to_first = poses_a[0].inverse();
-    const Isometry3d to_first_b = C.inverse() * to_first * C;
-    result.poses_a.resize(K);
-    result.poses_b.resize(K);
-    for (std::size_t k = 0; k < K; ++k) {
-      result.poses_a[k] = to_first * poses_a[k];
-      result.poses_b[k] =
-          to_first_b * pose_phase.target_pose(poses_a[k], t_a[k], t_b[k], twists[k]);
-    }
-    result.twists = twists;
-    result.calibration = calibration;
+    detail::output_poses(phase, p, C, twists, result);
+    result.calibration = cal.registration;
     if (progress)
       progress(static_cast<std::size_t>(round), static_cast<std::size_t>(options.max_rounds));
-    if (!usable) return fail(JeepStatus::registration_failed, calibration.reason);
-    settled = !previous_poses.empty() && trace.change_translation < options.settle_translation &&
-              trace.change_rotation < options.settle_rotation &&
-              trace.pose_change_translation < options.settle_translation &&
-              trace.pose_change_rotation < options.settle_rotation;
-    if (K == 1)  // no poses to settle: C alone decides
-      settled = trace.change_translation < options.settle_translation &&
-                trace.change_rotation < options.settle_rotation;
-    previous_poses = poses_a;
+    if (!usable) return fail(JeepStatus::registration_failed, cal.registration.reason);
+    settled = detail::settled(trace, previous_poses.empty(), p.size(), options);
+    previous_poses = phase.poses_a;
     if (settled && options.two_way) {
-      result.two_way = two_way_extrinsic(map_a, map_b, C, stages);
-      C = result.two_way.extrinsic;
-      result.extrinsic = C;
+      result.two_way = two_way_extrinsic(cal.map_a, cal.map_b, C, cal.stages);
+      C = result.extrinsic = result.two_way.extrinsic;
     }
-    if (settled || round == options.max_rounds) {
-      result.acceptance = assess(map_a, map_b, target, options.calibration, C, options.acceptance);
-      // In the output poses' frames (see to_first below).
-      const Isometry3d to_first = poses_a[0].inverse();
-      const Isometry3d to_first_b = C.inverse() * to_first * C;
-      for (const auto& p : downsampled(map_a, options.calibration.target_voxel).points)
-        result.map_a.push_back(to_first * p.template cast<double>());
-      for (const auto& p : downsampled(map_b, options.calibration.target_voxel).points)
-        result.map_b.push_back(to_first_b * p.template cast<double>());
-    }
+    if (settled || round == options.max_rounds)
+      detail::judge_last_round(phase, cal, C, options, result);
   }
   if (!settled)
     return fail(JeepStatus::not_converged,

@@ -27,6 +27,7 @@
 #include <tbb/parallel_for.h>
 
 #include "ulc/core/cloud.hpp"
+#include "ulc/core/gauss_newton.hpp"
 #include "ulc/core/kdtree.hpp"
 #include "ulc/core/lie.hpp"
 #include "ulc/core/normal_equations.hpp"
@@ -215,12 +216,39 @@ inline bool small_motion(const Isometry3d& T_old, const Isometry3d& T_new, const
   return moved < o.translation_tolerance && turned < o.rotation_tolerance;
 }
 
+/// Point-to-plane residuals over terms sharing the pose T, as gauss_newton.hpp's policy: each
+/// step solves the truncated, scaled normal equations around the matched points' centre c, and
+/// a move is small when it shifts c and turns less than the tolerances.
+template <typename S, class Target>
+struct PointToPlaneProblem {
+  using State = Isometry3d;
+  const std::vector<PointToPlaneTerm<S, Target>>& terms;
+  const RegistrationOptions& options;
+  PointToPlaneMatches matches;
+  Vec3d centre;  ///< of the last step's matched points
+
+  std::size_t match(const Isometry3d& T) {
+    return match_point_to_plane(terms, T, options.max_correspondence_distance, matches);
+  }
+  bool step(Isometry3d& T) {
+    const PointToPlaneSums sums = sum_matched_point_to_plane(terms, matches, T, options);
+    centre = sums.centre();
+    const ScaledSolve solve = solve_truncated(sums.equations.H, sums.equations.b, centre,
+                                              sums.spread(), options.min_condition);
+    const Isometry3d next = se3_exp(solve.step) * T;
+    const bool small = small_motion(T, next, centre, options);
+    T = next;
+    return small;
+  }
+  bool moved_little(const Isometry3d& from, const Isometry3d& to) const {
+    return small_motion(from, to, centre, options);
+  }
+};
+
 }  // namespace detail
 
-/// Gauss-Newton over several terms sharing the pose T (T_target_source for a single term).
-/// Each iteration matches every source point once, then takes Gauss-Newton steps with those
-/// matches fixed (IRLS weights refreshed every step) until a step is below the tolerances or
-/// max_solver_iterations. Converged when a whole iteration moved less than the tolerances.
+/// Gauss-Newton over several terms sharing the pose T (T_target_source for a single term), by
+/// gauss_newton.hpp's loop on detail::PointToPlaneProblem.
 template <typename S, class Target>
 RegistrationResult<double> register_point_to_plane_terms(
     const std::vector<PointToPlaneTerm<S, Target>>& terms, const Isometry3d& initial,
@@ -244,36 +272,15 @@ RegistrationResult<double> register_point_to_plane_terms(
     return result;
   }
 
+  detail::PointToPlaneProblem<S, Target> problem{terms, options, {}, Vec3d::Zero()};
   Isometry3d T = initial;
-  bool converged = false;
-  bool starved = false;
-  PointToPlaneMatches matches;
-  for (int it = 0; it < options.max_iterations; ++it) {
-    const std::size_t found =
-        match_point_to_plane(terms, T, options.max_correspondence_distance, matches);
-    ++result.iterations;
-    if (found < options.min_correspondences) {
-      starved = true;
-      break;
-    }
-    const Isometry3d T_matched = T;
-    Vec3d c = Vec3d::Zero();
-    for (int step = 0; step < options.max_solver_iterations; ++step) {
-      const PointToPlaneSums sums = sum_matched_point_to_plane(terms, matches, T, options);
-      c = sums.centre();
-      const ScaledSolve solve = solve_truncated(sums.equations.H, sums.equations.b, c,
-                                                sums.spread(), options.min_condition);
-      const Isometry3d T_next = se3_exp(solve.step) * T;
-      ++result.solver_iterations;
-      const bool small = detail::small_motion(T, T_next, c, options);
-      T = T_next;
-      if (small) break;
-    }
-    if (detail::small_motion(T_matched, T, c, options)) {
-      converged = true;
-      break;
-    }
-  }
+  const GaussNewtonRun run = gauss_newton(
+      problem, T,
+      {options.max_iterations, options.max_solver_iterations, options.min_correspondences});
+  result.iterations = run.iterations;
+  result.solver_iterations = run.solver_iterations;
+  const bool converged = run.converged, starved = run.starved;
+  PointToPlaneMatches& matches = problem.matches;
 
   result.pose = T;
   // Converged: T is within the tolerances of where the last matches were made, so they stand.

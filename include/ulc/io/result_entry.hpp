@@ -145,7 +145,8 @@ inline Json hots_to_json(const HotsReport& h) {
   Json j = Json::object();
   j["status"] = hots_status_text(h);
   j["reason"] = h.reason;
-  j["odometry_status"] = odometry::to_string(h.odometry_status);
+  // Skipped for want of frames: no odometry ran either.
+  j["odometry_status"] = h.run == HotsRun::skipped ? "" : odometry::to_string(h.odometry_status);
   j["odometry_reason"] = h.odometry_reason;
   j["odometry_failed_steps"] = h.odometry_failed_steps;
   j["frames_base"] = h.frames_base;
