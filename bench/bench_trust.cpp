@@ -117,7 +117,7 @@ void bench(const Config& c) {
           const auto odo = odometry::run_odometry(a.frames, a.timestamps, b.frames, b.timestamps, C,
                                                   o.tuning.odometry);
           if (!ulc::calibrate_detail::odometry_usable(odo)) {
-            row.push_back(std::string("odometry_") + jeep::to_string(odo.status));
+            row.push_back(std::string("odometry_") + odometry::to_string(odo.status));
             for (int k = 0; k < 6; ++k) row.push_back("-");
             table.add_row(row);
             return;
