@@ -72,8 +72,8 @@ struct CalibrateOptions {
   /// When HOTS runs on a moving rig, its cross links judge JEEP's extrinsic, not JEEP's own
   /// acceptance: a JEEP that settled but was rejected, or did not settle, hands its extrinsic
   /// to HOTS, and only HOTS's refusal (extrinsic_unconfirmed) ends the attempt. On narrow-FoV
-  /// targets JEEP's acceptance refuses right extrinsics (the seven-LiDAR rig's Tele, docs/
-  /// BENCHMARKS.md "TERRA's hypotheses"), while the cross links separate right from wrong.
+  /// targets JEEP's acceptance refuses right extrinsics (the seven-LiDAR rig's Tele,
+  /// docs/experiments/terra_hypotheses.md), while the cross links separate right from wrong.
   /// false: any JEEP failure ends the attempt. Not in the paper.
   bool hots_judges_jeep = true;
   jeep::JeepOptions jeep;          ///< K = 5 frame pairs, at most 10 rounds
