@@ -1,4 +1,4 @@
-// bench_peers: our point-to-plane ICP against PCL's and Open3D's on the same clouds (issue 5).
+// bench_peers: our point-to-plane ICP against PCL's and Open3D's on the same clouds.
 //
 //   bench_peers [--seed 3] [--disturbances 5] [--threads 2] [--repeats 5] [--json]
 //

@@ -12,7 +12,7 @@
 // Per target: e_rot (deg) and e_trans (cm) against the simulator's mounts, the calibration's
 // status, the route, the clock offset error when HOTS ran, the cross links of the kept result
 // (agreeing with the extrinsic / kept / attempted: HOTS's trust rule, include/hots/hots.hpp),
-// the wall time of its calibrations (direct + routed); "bar" is issue 7's: e_rot < 0.1 deg and
+// the wall time of its calibrations (direct + routed); "bar" is the rig bar: e_rot < 0.1 deg and
 // e_trans < 2 cm (and status ok). Per cycle: the closure error of T_base_i * T_i_j * T_base_j^-1
 // and the i -> j status and time. One run per scenario (seed --seed): the figures are single
 // measurements, not medians.
@@ -156,7 +156,7 @@ void bench(const Config& c) {
       {"route", c.route ? "on" : "off"},
       {"initial_guess", "none"}};
   const std::vector<std::pair<std::string, Cell>> notes{
-      {"bar", "issue 7: status ok and e_rot < 0.1 deg and e_trans < 2 cm"},
+      {"bar", "the rig bar: status ok and e_rot < 0.1 deg and e_trans < 2 cm"},
       {"closure", "T_base_i * T_i_j * T_base_j^-1, with T_i_j from terra,jeep on i and j"},
       {"time_s", "wall time of the target's calibrations (direct + routed) / of the cycle's"}};
   if (c.bench.json) {

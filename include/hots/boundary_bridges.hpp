@@ -13,7 +13,7 @@
 //     marginal_information). The near-side members' factors are left out: their windows already
 //     gave them, from the same points. Bridges never move the hierarchy's poses; the pose graph
 //     weighs them with the rest.
-//   - Why (docs/BENCHMARKS.md, "Bridges over the top-layer boundaries"): tied only by a
+//   - Why (docs/experiments/boundary_bridges.md): tied only by a
 //     registration of two whole top submaps or by the odometry's step, a boundary passed on the
 //     step's tilt error to the rest of the drive (60 s 64-32, seed 1: 0.15 deg at frame 125, 39
 //     cm of height by the end); a BA over the members on both sides ties the two submaps as

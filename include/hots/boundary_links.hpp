@@ -6,8 +6,9 @@
 //     submap to the first of the next) did, but it is only as good as those two frames: one
 //     odometry glitch there (a speed bump's pitch, a turn's entry: frames the constant-velocity
 //     deskew gets wrong) was locked into the graph and tilted the rest of the drive (60 s 64-32,
-//     seed 2: 0.9 m of height error; docs/BENCHMARKS.md). Two whole submaps overlap over tens
-//     of metres and register to each other far more reliably than two frames.
+//     seed 2: 0.9 m of height error; docs/experiments/boundary_registration.md). Two whole
+//     submaps overlap over tens of metres and register to each other far more reliably than
+//     two frames.
 //   - Link m: submap m + 1's cloud (source) to submap m's planes (target), from the current
 //     relative pose of their anchors (the odometry's across the boundary, the BA's inside), by
 //     register_clouds (cross_links.hpp): Z = T_anchor_m^-1 T_anchor_m+1 with the
@@ -18,7 +19,7 @@
 //     points without a partner and can fail CrossLinkOptions::min_inlier_ratio (60 s 64-32:
 //     4-6 of 8 boundaries registered). A 40 m crop registered all 8 but did not make the
 //     trajectory better (best-aligned ATE, seeds 1-3: 2.06 / 3.96 / 2.43 cm whole, 1.94 /
-//     5.28 / 2.60 cm cropped; docs/BENCHMARKS.md, "Top-layer boundaries registered"), so the
+//     5.28 / 2.60 cm cropped; docs/experiments/boundary_registration.md), so the
 //     default is no crop.
 //   - Boundaries marked in `skip` (those a bridge BA already ties, boundary_bridges.hpp) are
 //     not registered.

@@ -54,7 +54,7 @@
 //     links, before the pose graph (the result's extrinsic and poses are then the inputs). The
 //     graph cannot repair such a start: its ties hold C where it began and a planar drive leaves
 //     the two trajectories' consistency degenerate. Measured (bench_trust and the seven-LiDAR rig,
-//     docs/BENCHMARKS.md "Cross links as the extrinsic's evidence"): wrong extrinsics JEEP accepted
+//     docs/experiments/cross_link_agreement.md): wrong extrinsics JEEP accepted
 //     had 0-1 agreeing links of 90 (64-tele, horizon-tele) and 0 of 538 (the rig's Tele, whose 27
 //     kept links all moved 1.6-14.8 deg); right ones on the Tele pairs at least 8 of 90 and 35 of
 //     538.

@@ -40,7 +40,8 @@
 //     whole solve's answer, gives offsets within max_time_disagreement_s of each other; and
 //     (3) the offset kept (adopted or the start) is that close to the whole solve's. The
 //     cluster-robust sigma sees noise, not bias: on a short drive the joint cost has minima
-//     tens of milliseconds off with a sigma of 0.1 ms (docs/BENCHMARKS.md). A distrusted
+//     tens of milliseconds off with a sigma of 0.1 ms
+//     (docs/experiments/time_offset_drive_length.md). A distrusted
 //     offset is reported (time_offset_trusted, time_offset_doubt); it does not change C or dt.
 //   - The result keeps C and dt of the input when the registration fails (status says why).
 //   - Nothing here throws or prints; the same results for any number of threads (per-term

@@ -37,15 +37,15 @@
 //     unrelated maps sits in the ground's three directions; along the road, across it or in
 //     yaw their near points mostly disagree, and the directional overlap falls to 0.05-0.28,
 //     while at the truth it is 0.17-0.94 (every direction is supported by some surface both
-//     saw). 0.25 was chosen on seeds 2 and 3, not on the accuracy drives (docs/BENCHMARKS.md,
-//     "The acceptance rule's directional overlap"): it accepted 2 of 85 unrelated pairs without
+//     saw). 0.25 was chosen on seeds 2 and 3, not on the accuracy drives
+//     (docs/experiments/directional_overlap.md): it accepted 2 of 85 unrelated pairs without
 //     a Tele and 2 of 27 with one, where overlap >= 0.6 accepted 21 and 22.
 //   - Why off the ground: any two roads agree in the ground's three directions,
 //     so they tell nothing about a coincidence, and on sparse pairs they were what refused
 //     right answers: a VLP-32C's planes between its far rings are extrapolated, and 70-77 % of
 //     a Livox Avia's near ground points lie more than 10 cm from them at the truth, which made
-//     the weakest direction vertical (0.15-0.19; docs/BENCHMARKS.md, "Why 32-avia's
-//     end-of-drive results are refused"). The threshold stays 0.25: unrelated maps fail off
+//     the weakest direction vertical (0.15-0.19;
+//     docs/experiments/avia_end_of_drive.md). The threshold stays 0.25: unrelated maps fail off
 //     the ground already (for 105 of the 112 settled unrelated pairs of the selection seeds the
 //     two overlaps differ by less than 0.01). The six-direction overlap keeps a floor of
 //     0.10, so that maps that disagree on the ground itself (a wrong height) are still
@@ -53,7 +53,8 @@
 //     >= 0.255 off the ground (>= 0.213 over six directions); the unrelated pairs accepted
 //     without a Tele were the same two of 85 as with the six directions alone, and with a Tele
 //     2 of 27 (1 before)
-//     (docs/BENCHMARKS.md, "The acceptance rule off the ground").
+//     (docs/experiments/acceptance_off_ground.md; current figures: docs/BENCHMARKS.md,
+//     "bench_jeep").
 //   - min_condition is the registration's own degeneracy threshold: an alignment resting on
 //     the ground alone is not a calibration. bench_jeep --separation measures both
 //     distributions on the paper's pairs (docs/design.md: measure, do not guess).

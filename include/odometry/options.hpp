@@ -38,7 +38,8 @@ struct OdometryOptions {
   /// the constant-velocity prediction is a few decimetres off, e.g. when the vehicle brakes
   /// or accelerates; the next prediction is then worse and the odometry runs away (60 s 64-32
   /// drives, seeds 1-3: ATE 19-40 m with it, 0.17-0.37 m without, at the same speed;
-  /// docs/BENCHMARKS.md). JEEP's later rounds use it: they start from settled poses.
+  /// docs/experiments/odometry_runaway.md). JEEP's later rounds use it: they start from
+  /// settled poses.
   bool single_stage = false;
   int max_iterations = 30;              ///< correspondence searches per stage
   double translation_tolerance = 5e-4;  ///< m, second stage (the first: 1e-3)

@@ -66,35 +66,27 @@ inline Isometry3d extrapolate(const OdometryStep& s, double t) {
   return s.pose_a * ulc::se3_exp(Vec6d((t - s.t_a) * s.twist));
 }
 
-template <class FramesA, class FramesB, typename S>
-OdometryResult run(const FramesA& frames_a, const std::vector<double>& times_a,
-                   const FramesB* frames_b, const std::vector<double>* times_b,
-                   const std::optional<Isometry3d>& C, const OdometryOptions& options,
-                   const ProgressFn& progress) {
-  OdometryResult result;
-  auto fail = [&](OdometryStatus s, const char* why) {
-    result.status = s;
-    result.reason = why;
-    return result;
-  };
-  if (!valid_odometry_options(options)) return fail(OdometryStatus::invalid_input, "bad options");
+/// Why the odometry cannot run; nullptr when it can.
+template <class FramesA, class FramesB>
+const char* input_problem(const FramesA& frames_a, const std::vector<double>& times_a,
+                          const FramesB* frames_b, const std::vector<double>* times_b,
+                          const std::optional<Isometry3d>& C, const OdometryOptions& options) {
+  if (!valid_odometry_options(options)) return "bad options";
   if (frames_a.size() != times_a.size() || (frames_b && frames_b->size() != times_b->size()))
-    return fail(OdometryStatus::invalid_input, "frame and timestamp counts differ");
+    return "frame and timestamp counts differ";
   if (!timestamps_usable(times_a) || (times_b && !timestamps_usable(*times_b)))
-    return fail(OdometryStatus::invalid_input, "timestamps not finite and nondecreasing");
-  if (C && !C->matrix().allFinite())
-    return fail(OdometryStatus::invalid_input, "extrinsic not finite");
+    return "timestamps not finite and nondecreasing";
+  if (C && !C->matrix().allFinite()) return "extrinsic not finite";
+  return nullptr;
+}
+
+/// One step per frame pair (a alone: one per frame), each scan deskewed with the current twist.
+template <typename S, class FramesA, class FramesB>
+void run_steps(const FramesA& frames_a, const std::vector<double>& times_a, const FramesB* frames_b,
+               const std::vector<double>* times_b, const OdometryOptions& options,
+               const ProgressFn& progress, Odometry<S>& odometry, OdometryResult& result) {
   const double period_a = frame_period(times_a);
   const double period_b = times_b ? frame_period(*times_b) : period_a;
-  if (frames_b) {
-    result.pairs =
-        pair_frames(times_a, *times_b, options.time_offset_s, options.max_pair_gap * period_a);
-  } else {
-    for (std::size_t i = 0; i < times_a.size(); ++i) result.pairs.push_back({i, i});
-  }
-  if (result.pairs.empty()) return fail(OdometryStatus::no_pairs, "no frames to pair");
-
-  Odometry<S> odometry(options, C);
   for (std::size_t k = 0; k < result.pairs.size(); ++k) {
     const FramePair& pair = result.pairs[k];
     const Vec6d xi = odometry.twist();
@@ -110,33 +102,43 @@ OdometryResult run(const FramesA& frames_a, const std::vector<double>& times_a,
     if (k > 0 && !result.steps.back().registered) ++result.failed_steps;
     if (progress) progress(k + 1, result.pairs.size());
   }
+}
 
-  // Poses at the timestamps from the mid-sweep poses and central-difference twists (better
-  // than the steps' backward ones), then re-expressed in a's frame at its first timestamp.
-  {
-    std::vector<Isometry3d> mids;
-    std::vector<double> mid_times;
-    for (const OdometryStep& s : result.steps) {
-      mids.push_back(s.mid_pose_a);
-      mid_times.push_back(s.mid_time);
-    }
-    const auto twists = twists_from_mid_poses(mids, mid_times, result.steps[0].twist);
-    for (std::size_t k = 0; k < result.steps.size(); ++k) {
-      OdometryStep& s = result.steps[k];
-      s.twist = twists[k];
-      s.pose_a = s.mid_pose_a * ulc::se3_exp(Vec6d((s.t_a - s.mid_time) * s.twist));
-      if (C) s.pose_b = odometry.target_pose(s.pose_a, s.t_a, s.t_b, s.twist);
-    }
-    const Isometry3d to_first = result.steps[0].pose_a.inverse();
-    const Isometry3d to_first_b = C ? Isometry3d(C->inverse() * to_first * *C) : to_first;
-    for (OdometryStep& s : result.steps) {
-      s.pose_a = to_first * s.pose_a;
-      s.mid_pose_a = to_first * s.mid_pose_a;
-      s.scan_pose_a = to_first * s.scan_pose_a;
-      s.pose_b = to_first_b * s.pose_b;
-      s.scan_pose_b = to_first_b * s.scan_pose_b;
-    }
+/// The steps' poses at the timestamps from the mid-sweep poses and central-difference twists
+/// (better than the steps' backward ones), re-expressed in a's frame at its first timestamp.
+template <typename S>
+void settle_step_poses(const Odometry<S>& odometry, const std::optional<Isometry3d>& C,
+                       std::vector<OdometryStep>& steps) {
+  std::vector<Isometry3d> mids;
+  std::vector<double> mid_times;
+  for (const OdometryStep& s : steps) {
+    mids.push_back(s.mid_pose_a);
+    mid_times.push_back(s.mid_time);
   }
+  const auto twists = twists_from_mid_poses(mids, mid_times, steps[0].twist);
+  for (std::size_t k = 0; k < steps.size(); ++k) {
+    OdometryStep& s = steps[k];
+    s.twist = twists[k];
+    s.pose_a = s.mid_pose_a * ulc::se3_exp(Vec6d((s.t_a - s.mid_time) * s.twist));
+    if (C) s.pose_b = odometry.target_pose(s.pose_a, s.t_a, s.t_b, s.twist);
+  }
+  const Isometry3d to_first = steps[0].pose_a.inverse();
+  const Isometry3d to_first_b = C ? Isometry3d(C->inverse() * to_first * *C) : to_first;
+  for (OdometryStep& s : steps) {
+    s.pose_a = to_first * s.pose_a;
+    s.mid_pose_a = to_first * s.mid_pose_a;
+    s.scan_pose_a = to_first * s.scan_pose_a;
+    s.pose_b = to_first_b * s.pose_b;
+    s.scan_pose_b = to_first_b * s.scan_pose_b;
+  }
+}
+
+/// A pose for every frame: the paired frames their step's, the others extrapolated from the
+/// nearest step in time with its twist.
+template <typename S>
+void frame_poses(const Odometry<S>& odometry, const std::vector<double>& times_a,
+                 const std::vector<double>* times_b, const OdometryOptions& options,
+                 OdometryResult& result) {
   result.poses_a.resize(times_a.size());
   result.estimated_a.assign(times_a.size(), false);
   for (std::size_t i = 0; i < times_a.size(); ++i)
@@ -146,25 +148,48 @@ OdometryResult run(const FramesA& frames_a, const std::vector<double>& times_a,
     result.poses_a[result.pairs[k].a] = result.steps[k].pose_a;
     result.estimated_a[result.pairs[k].a] = true;
   }
+  if (!times_b) return;
+  result.poses_b.resize(times_b->size());
+  result.estimated_b.assign(times_b->size(), false);
+  for (std::size_t j = 0; j < times_b->size(); ++j) {
+    const double t = (*times_b)[j] + options.time_offset_s;
+    const OdometryStep& s = result.steps[nearest_step(result.steps, t)];
+    result.poses_b[j] = odometry.target_pose(s.pose_a, s.t_a, t, s.twist);
+  }
+  for (std::size_t k = 0; k < result.pairs.size(); ++k) {
+    result.poses_b[result.pairs[k].b] = result.steps[k].pose_b;
+    result.estimated_b[result.pairs[k].b] = true;
+  }
+}
+
+template <class FramesA, class FramesB, typename S>
+OdometryResult run(const FramesA& frames_a, const std::vector<double>& times_a,
+                   const FramesB* frames_b, const std::vector<double>* times_b,
+                   const std::optional<Isometry3d>& C, const OdometryOptions& options,
+                   const ProgressFn& progress) {
+  OdometryResult result;
+  auto fail = [&](OdometryStatus s, const char* why) {
+    result.status = s;
+    result.reason = why;
+    return result;
+  };
+  if (const char* why = input_problem(frames_a, times_a, frames_b, times_b, C, options))
+    return fail(OdometryStatus::invalid_input, why);
   if (frames_b) {
-    result.poses_b.resize(times_b->size());
-    result.estimated_b.assign(times_b->size(), false);
-    for (std::size_t j = 0; j < times_b->size(); ++j) {
-      const double t = (*times_b)[j] + options.time_offset_s;
-      const OdometryStep& s = result.steps[nearest_step(result.steps, t)];
-      result.poses_b[j] = odometry.target_pose(s.pose_a, s.t_a, t, s.twist);
-    }
-    for (std::size_t k = 0; k < result.pairs.size(); ++k) {
-      result.poses_b[result.pairs[k].b] = result.steps[k].pose_b;
-      result.estimated_b[result.pairs[k].b] = true;
-    }
+    result.pairs = pair_frames(times_a, *times_b, options.time_offset_s,
+                               options.max_pair_gap * frame_period(times_a));
+  } else {
+    for (std::size_t i = 0; i < times_a.size(); ++i) result.pairs.push_back({i, i});
   }
-  if (result.failed_steps > 0) {
-    result.status = OdometryStatus::registration_failed;
-    result.reason =
-        "some frames could not be registered (too few correspondences); their "
-        "poses are predictions";
-  }
+  if (result.pairs.empty()) return fail(OdometryStatus::no_pairs, "no frames to pair");
+  Odometry<S> odometry(options, C);
+  run_steps<S>(frames_a, times_a, frames_b, times_b, options, progress, odometry, result);
+  settle_step_poses(odometry, C, result.steps);
+  frame_poses(odometry, times_a, frames_b ? times_b : nullptr, options, result);
+  if (result.failed_steps > 0)
+    return fail(OdometryStatus::registration_failed,
+                "some frames could not be registered (too few correspondences); their poses are "
+                "predictions");
   return result;
 }
 

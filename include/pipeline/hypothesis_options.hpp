@@ -26,7 +26,7 @@ struct HypothesisOptions {
   /// acceptance: a JEEP that settled but was rejected, or did not settle, hands its extrinsic
   /// to HOTS, and only HOTS's refusal (extrinsic_unconfirmed) ends the attempt. On narrow-FoV
   /// targets JEEP's acceptance refuses right extrinsics (the seven-LiDAR rig's Tele,
-  /// docs/BENCHMARKS.md "TERRA's hypotheses"), while the cross links separate right from wrong.
+  /// docs/experiments/terra_hypotheses.md), while the cross links separate right from wrong.
   /// false: any JEEP failure ends the attempt.
   bool hots_judges_jeep = true;
 };

@@ -186,13 +186,123 @@ std::string check_input(const std::vector<RigLidar<Frames>>& lidars, std::size_t
   return {};
 }
 
+/// Every target against the base, directly.
+template <class Frames>
+void calibrate_directly(const std::vector<RigLidar<Frames>>& lidars, std::size_t base,
+                        const RigOptions& options, RigCalibration& rig) {
+  for (std::size_t k = 0; k < lidars.size(); ++k) {
+    if (k == base) continue;
+    RigTarget t;
+    t.lidar = k;
+    t.name = lidars[k].name;
+    t.direct = calibrate(lidars[base], lidars[k],
+                         pair_options(options.pair, t.name + " ", lidars[k].initial));
+    t.result = t.direct;
+    rig.targets.push_back(std::move(t));
+  }
+}
+
+/// The targets calibrated directly, best first (JEEP's overlap, then the name).
+inline std::vector<std::size_t> route_candidates(const std::vector<RigTarget>& targets) {
+  std::vector<std::size_t> candidates;
+  for (std::size_t n = 0; n < targets.size(); ++n)
+    if (targets[n].direct.success) candidates.push_back(n);
+  std::stable_sort(candidates.begin(), candidates.end(), [&](std::size_t x, std::size_t y) {
+    const double ox = overlap_of(targets[x].direct);
+    const double oy = overlap_of(targets[y].direct);
+    if (ox != oy) return ox > oy;
+    return targets[x].name < targets[y].name;
+  });
+  return candidates;
+}
+
+/// A failed target through each candidate in turn until one calibrates it.
+template <class Frames>
+void route(const std::vector<RigLidar<Frames>>& lidars, const std::vector<std::size_t>& candidates,
+           const RigOptions& options, const std::vector<RigTarget>& targets, RigTarget& t) {
+  for (const std::size_t n : candidates) {
+    const RigTarget& v = targets[n];
+    std::optional<Isometry3d> guess;
+    if (lidars[t.lidar].initial)
+      guess = v.direct.T_base_target.inverse() * *lidars[t.lidar].initial;
+    const PairCalibration c =
+        calibrate(lidars[v.lidar], lidars[t.lidar],
+                  pair_options(options.pair, t.name + " via " + v.name + " ", guess));
+    if (!c.success) {
+      t.failed_routes.push_back({v.lidar, v.name, c.status, c.reason});
+      continue;
+    }
+    t.via = v.lidar;
+    t.via_name = v.name;
+    t.via_pair = c;
+    t.result = chained(v.direct, c, t.direct, v.name);
+    return;
+  }
+  if (t.failed_routes.empty()) return;
+  t.result.reason += "; no route worked either:";
+  for (const RigRouteAttempt& a : t.failed_routes)
+    t.result.reason += std::string(" through ") + a.via_name + ": " + to_string(a.status) +
+                       (&a == &t.failed_routes.back() ? "" : ",");
+}
+
+/// The cycle base -> i -> j -> base of two calibrated targets: i against j from the chain's
+/// prediction, and how far the loop is from closing.
+template <class Frames>
+RigCycle close_cycle(const std::vector<RigLidar<Frames>>& lidars, const RigTarget& ti,
+                     const RigTarget& tj, const RigOptions& options) {
+  CalibrateOptions o = pair_options(options.pair, "cycle " + ti.name + "-" + tj.name + " ",
+                                    ti.result.T_base_target.inverse() * tj.result.T_base_target);
+  o.stages = options.cycle_stages;
+  RigCycle c;
+  c.i = ti.lidar;
+  c.j = tj.lidar;
+  c.name_i = ti.name;
+  c.name_j = tj.name;
+  c.pair = calibrate(lidars[ti.lidar], lidars[tj.lidar], o);
+  if (c.pair.success) {
+    const Isometry3d E =
+        ti.result.T_base_target * c.pair.T_base_target * tj.result.T_base_target.inverse();
+    const PoseError e = pose_error(Isometry3d(Isometry3d::Identity()), E);
+    c.rotation_deg = e.rotation_deg;
+    c.translation_m = e.translation_m;
+  }
+  return c;
+}
+
+/// Every pair of calibrated targets not routed through each other, up to max_cycles.
+template <class Frames>
+void check_cycles(const std::vector<RigLidar<Frames>>& lidars, const RigOptions& options,
+                  RigCalibration& rig) {
+  for (std::size_t x = 0; x < rig.targets.size(); ++x) {
+    for (std::size_t y = x + 1; y < rig.targets.size(); ++y) {
+      const RigTarget& ti = rig.targets[x];
+      const RigTarget& tj = rig.targets[y];
+      if (!ti.ok() || !tj.ok()) continue;
+      // A target routed through the other IS this cycle: it closes by construction.
+      if (ti.via == tj.lidar || tj.via == ti.lidar) continue;
+      if (rig.cycles.size() >= options.max_cycles) break;
+      rig.cycles.push_back(close_cycle(lidars, ti, tj, options));
+    }
+  }
+}
+
+/// ok when every target calibrated, else which did not.
+inline void judge_rig(RigCalibration& rig) {
+  bool all = true;
+  for (const RigTarget& t : rig.targets) all = all && t.ok();
+  rig.status = all ? RigStatus::ok : RigStatus::targets_failed;
+  if (all) return;
+  rig.reason = "not calibrated:";
+  for (const RigTarget& t : rig.targets)
+    if (!t.ok()) rig.reason += " " + t.name;
+}
+
 }  // namespace rig_detail
 
 /// Calibrates every LiDAR of `lidars` but `base` against the base (see the conventions above).
 template <class Frames>
 RigCalibration calibrate_rig(const std::vector<RigLidar<Frames>>& lidars, std::size_t base,
                              const RigOptions& options = {}) {
-  using rig_detail::pair_options;
   const auto start = std::chrono::steady_clock::now();
   RigCalibration rig;
   rig.base = base;
@@ -200,99 +310,16 @@ RigCalibration calibrate_rig(const std::vector<RigLidar<Frames>>& lidars, std::s
     rig.reason = std::move(why);
     return rig;
   }
-  const RigLidar<Frames>& b = lidars[base];
-  rig.base_name = b.name;
-
-  for (std::size_t k = 0; k < lidars.size(); ++k) {
-    if (k == base) continue;
-    RigTarget t;
-    t.lidar = k;
-    t.name = lidars[k].name;
-    t.direct = rig_detail::calibrate(b, lidars[k],
-                                     pair_options(options.pair, t.name + " ", lidars[k].initial));
-    t.result = t.direct;
-    rig.targets.push_back(std::move(t));
-  }
-
+  rig.base_name = lidars[base].name;
+  rig_detail::calibrate_directly(lidars, base, options, rig);
   if (options.route) {
-    // Candidates: the targets calibrated directly, best first (fixed before any routing).
-    std::vector<std::size_t> candidates;
-    for (std::size_t n = 0; n < rig.targets.size(); ++n)
-      if (rig.targets[n].direct.success) candidates.push_back(n);
-    std::stable_sort(candidates.begin(), candidates.end(), [&](std::size_t x, std::size_t y) {
-      const double ox = rig_detail::overlap_of(rig.targets[x].direct);
-      const double oy = rig_detail::overlap_of(rig.targets[y].direct);
-      if (ox != oy) return ox > oy;
-      return rig.targets[x].name < rig.targets[y].name;
-    });
-    for (RigTarget& t : rig.targets) {
-      if (t.direct.success) continue;
-      for (const std::size_t n : candidates) {
-        const RigTarget& v = rig.targets[n];
-        std::optional<Isometry3d> guess;
-        if (lidars[t.lidar].initial)
-          guess = v.direct.T_base_target.inverse() * *lidars[t.lidar].initial;
-        const PairCalibration c = rig_detail::calibrate(
-            lidars[v.lidar], lidars[t.lidar],
-            pair_options(options.pair, t.name + " via " + v.name + " ", guess));
-        if (!c.success) {
-          t.failed_routes.push_back({v.lidar, v.name, c.status, c.reason});
-          continue;
-        }
-        t.via = v.lidar;
-        t.via_name = v.name;
-        t.via_pair = c;
-        t.result = rig_detail::chained(v.direct, c, t.direct, v.name);
-        break;
-      }
-      if (!t.routed() && !t.failed_routes.empty()) {
-        t.result.reason += "; no route worked either:";
-        for (const RigRouteAttempt& a : t.failed_routes)
-          t.result.reason += std::string(" through ") + a.via_name + ": " + to_string(a.status) +
-                             (&a == &t.failed_routes.back() ? "" : ",");
-      }
-    }
+    // Candidates fixed before any routing.
+    const std::vector<std::size_t> candidates = rig_detail::route_candidates(rig.targets);
+    for (RigTarget& t : rig.targets)
+      if (!t.direct.success) rig_detail::route(lidars, candidates, options, rig.targets, t);
   }
-
-  if (options.cycles) {
-    for (std::size_t x = 0; x < rig.targets.size(); ++x) {
-      for (std::size_t y = x + 1; y < rig.targets.size(); ++y) {
-        const RigTarget& ti = rig.targets[x];
-        const RigTarget& tj = rig.targets[y];
-        if (!ti.ok() || !tj.ok()) continue;
-        // A target routed through the other IS this cycle: it closes by construction.
-        if (ti.via == tj.lidar || tj.via == ti.lidar) continue;
-        if (rig.cycles.size() >= options.max_cycles) break;
-        CalibrateOptions o =
-            pair_options(options.pair, "cycle " + ti.name + "-" + tj.name + " ",
-                         ti.result.T_base_target.inverse() * tj.result.T_base_target);
-        o.stages = options.cycle_stages;
-        RigCycle c;
-        c.i = ti.lidar;
-        c.j = tj.lidar;
-        c.name_i = ti.name;
-        c.name_j = tj.name;
-        c.pair = rig_detail::calibrate(lidars[ti.lidar], lidars[tj.lidar], o);
-        if (c.pair.success) {
-          const Isometry3d E =
-              ti.result.T_base_target * c.pair.T_base_target * tj.result.T_base_target.inverse();
-          const PoseError e = pose_error(Isometry3d(Isometry3d::Identity()), E);
-          c.rotation_deg = e.rotation_deg;
-          c.translation_m = e.translation_m;
-        }
-        rig.cycles.push_back(std::move(c));
-      }
-    }
-  }
-
-  bool all = true;
-  for (const RigTarget& t : rig.targets) all = all && t.ok();
-  rig.status = all ? RigStatus::ok : RigStatus::targets_failed;
-  if (!all) {
-    rig.reason = "not calibrated:";
-    for (const RigTarget& t : rig.targets)
-      if (!t.ok()) rig.reason += " " + t.name;
-  }
+  if (options.cycles) rig_detail::check_cycles(lidars, options, rig);
+  rig_detail::judge_rig(rig);
   rig.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return rig;
 }

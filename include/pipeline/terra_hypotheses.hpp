@@ -17,7 +17,7 @@
 // of one already tried. Why:
 // on the 90-deg-pitched VLP-16 (pitched-90, seed 1, 10 s) the map search's five optima are all
 // 74-153 deg off, while the frame search's seventh is 3.2 deg off and leads JEEP and HOTS to
-// 0.016 deg / 0.31 cm (docs/BENCHMARKS.md, "TERRA's fallback hypotheses").
+// 0.016 deg / 0.31 cm (docs/experiments/terra_fallback_hypotheses.md).
 //
 // Nothing here throws; deterministic (ordered comparisons only).
 #pragma once

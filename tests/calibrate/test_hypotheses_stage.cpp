@@ -118,7 +118,7 @@ TEST_CASE("a JEEP that did not settle is judged by HOTS, which confirms and refi
 
 TEST_CASE("the fallback finds the 90-deg-pitched VLP-16 where the map search's optima all fail",
           "[calibrate][hypotheses][fallback]") {
-  // pitched-90, seed 2, 10 s (docs/BENCHMARKS.md, "TERRA's fallback hypotheses"): the frames
+  // pitched-90, seed 2, 10 s (docs/experiments/terra_fallback_hypotheses.md): the frames
   // overlap in a few cells, so the automatic rule keeps the maps, whose optima are all far from
   // the truth; one of the frame search's lower optima is within JEEP's reach.
   ulc::sim::SimulationOptions so;
