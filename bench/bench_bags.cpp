@@ -20,7 +20,6 @@
 #include <string>
 #include <vector>
 
-#include "support/bench_args.hpp"
 #include "support/bench_util.hpp"
 #include "ulc/bags/cloud_encoding.hpp"
 #include "ulc/bags/cloud_topic.hpp"
@@ -168,12 +167,16 @@ int main(int argc, char** argv) {
   }
   double gb = 1.0, big_gb = 4.0;
   fs::path dir = fs::temp_directory_path() / "ulc_bench_bags";
-  ulc_bench::Args args;
-  args.value("--gb", ulc_bench::number(gb))
-      .value("--big-gb", ulc_bench::number(big_gb))
-      .value("--dir", [&](const char* s) { dir = s; });
-  ulc_bench::Options options = args.parse(
-      argc, argv, "recordings read into clouds: MB/s and peak memory (--gb, --big-gb, --dir)");
+  CLI::App app("recordings read into clouds: MB/s and peak memory", "bench_bags");
+  ulc_bench::Options options;
+  ulc_bench::add_options(app, options);
+  app.add_option("--gb", gb, "size of the first recording of each format (default 1)")
+      ->type_name("G");
+  app.add_option("--big-gb", big_gb, "size of the second, read once (default 4; 0: none)")
+      ->type_name("G");
+  app.add_option("--dir", dir, "where the recordings are written (default: a temporary folder)")
+      ->type_name("DIR");
+  CLI11_PARSE(app, argc, argv);
   fs::create_directories(dir);
   const auto frames = simulated_frames();
 

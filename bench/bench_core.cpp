@@ -139,8 +139,11 @@ std::uint64_t bits(double x) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const auto options = ulc_bench::parse_options(
-      argc, argv, "kd-tree, kNN, normals and voxel downsampling on 100k points, 1 and 2 threads");
+  CLI::App app("kd-tree, kNN, normals and voxel downsampling on 100k points, 1 and 2 threads",
+               "bench_core");
+  ulc_bench::Options options;
+  ulc_bench::add_options(app, options);
+  CLI11_PARSE(app, argc, argv);
   const Cloud cloud = make_scene();
   const ulc::KdTree<Cloud> tree(cloud);
 

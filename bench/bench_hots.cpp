@@ -64,7 +64,6 @@
 #include "odometry/run_odometry.hpp"
 #include "pipeline/calibrate.hpp"
 #include "pipeline/pipeline.hpp"
-#include "support/bench_args.hpp"
 #include "support/bench_util.hpp"
 #include "support/curve_png.hpp"
 #include "ulc/core/pose_error.hpp"
@@ -309,7 +308,7 @@ Run one_run(const std::string& scenario, double offset_s, std::size_t run, const
         odometry::run_odometry(a.frames, a.timestamps, b.frames, times_b, C, o.tuning.odometry);
     out.odometry_s = seconds_since(t0);
     if (!ulc::calibrate_detail::odometry_usable(odo)) {
-      out.status = std::string("odometry_") + jeep::to_string(odo.status);
+      out.status = std::string("odometry_") + odometry::to_string(odo.status);
       return;
     }
     out.ate_odometry = ate(d, 0, odo.poses_a);
@@ -509,28 +508,54 @@ void bench(Config c) {
 
 int main(int argc, char** argv) {
   Config c;
-  ulc_bench::Args args;
-  args.flag("--accuracy", [&] { c.mode = "accuracy"; })
-      .flag("--time-offset", [&] { c.mode = "time-offset"; })
-      .value("--scenarios", ulc_bench::list(c.scenarios))
-      .value("--seconds", ulc_bench::number(c.seconds))
-      .value("--runs", ulc_bench::at_least(c.runs, std::size_t{1}))
-      .value("--first-run", ulc_bench::at_least(c.first_run, std::size_t{0}))
-      .value("--decimation", ulc_bench::at_least(c.decimation, 1u))
-      .value("--threads", ulc_bench::at_least(c.threads, 1))
-      .value("--spread-png", ulc_bench::text(c.spread_png))
-      .value("--offset-ms", [&](const char* s) { c.offsets_s = {std::atof(s) * 1e-3}; })
-      .value("--pre-shift-ms", ulc_bench::number(c.pre_shift_s, 1e-3))
-      .value("--layers", ulc_bench::at_least(c.layers, 1))
-      .value("--trajectory", ulc_bench::text(c.trajectory))
-      .value("--hots", ulc_bench::append(c.hots_settings))
-      .value("--steering-ramp", ulc_bench::number(c.steering_ramp_m))
-      .flag("--no-traffic", [&] { c.no_traffic = true; })
-      .flag("--jeep-decides", [&] { c.hots_judges_jeep = false; });
-  c.bench = args.parse(argc, argv,
-                       "HOTS after JEEP on simulated drives (modes: --accuracy --time-offset; "
-                       "options --scenarios --seconds --runs --first-run --decimation --threads "
-                       "--spread-png)");
+  CLI::App app(
+      "HOTS after JEEP on simulated drives, against the ground truth (modes: --accuracy, "
+      "--time-offset; see the top of bench/bench_hots.cpp)",
+      "bench_hots");
+  ulc_bench::add_options(app, c.bench);
+  app.add_flag_callback(
+      "--accuracy", [&] { c.mode = "accuracy"; }, "accuracy mode (default)");
+  app.add_flag_callback(
+      "--time-offset", [&] { c.mode = "time-offset"; },
+      "time-offset mode: target clock 50 ms behind, and no offset");
+  app.add_option("--scenarios", c.scenarios, "scenarios (default: the mode's)")
+      ->delimiter(',')
+      ->type_name("A,B,...");
+  app.add_option("--seconds", c.seconds, "simulated drive (default 60)")->type_name("S");
+  app.add_option("--runs", c.runs, "runs per scenario (default 10)")
+      ->type_name("N")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--first-run", c.first_run, "first run's index (default 0)")->type_name("K");
+  app.add_option("--decimation", c.decimation, "keep every Nth point (default 1)")
+      ->type_name("N")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--threads", c.threads, "worker threads (default 2)")
+      ->type_name("N")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--spread-png", c.spread_png, "draw run 0's spread curves to PREFIX_...png")
+      ->type_name("PREFIX");
+  app.add_option_function<double>(
+         "--offset-ms", [&](double ms) { c.offsets_s = {ms * 1e-3}; },
+         "--time-offset: only this offset")
+      ->type_name("X");
+  app.add_option_function<double>(
+         "--pre-shift-ms", [&](double ms) { c.pre_shift_s = ms * 1e-3; },
+         "shift the target's timestamps before HOTS")
+      ->type_name("X");
+  app.add_option("--layers", c.layers, "HOTS's hierarchy layers (default 3)")
+      ->type_name("N")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--trajectory", c.trajectory, "per run, PREFIX_<scenario>_run<k>.csv")
+      ->type_name("PREFIX");
+  app.add_option("--hots", c.hots_settings, "one of HOTS's numeric options (repeatable)")
+      ->type_name("NAME=VALUE")
+      ->allow_extra_args(false);
+  app.add_option("--steering-ramp", c.steering_ramp_m, "route averaged over M metres")
+      ->type_name("M");
+  app.add_flag("--no-traffic", c.no_traffic, "no oncoming cars");
+  app.add_flag_callback(
+      "--jeep-decides", [&] { c.hots_judges_jeep = false; }, "a failed JEEP ends the run");
+  CLI11_PARSE(app, argc, argv);
   bench(c);
   return 0;
 }

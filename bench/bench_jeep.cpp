@@ -43,7 +43,6 @@
 #include "jeep/jeep.hpp"
 #include "jeep/scan_scan.hpp"
 #include "odometry/run_odometry.hpp"
-#include "support/bench_args.hpp"
 #include "support/bench_util.hpp"
 #include "support/heatmap_png.hpp"
 #include "ulc/core/pose_error.hpp"
@@ -458,7 +457,7 @@ void frames_sweep(Config c) {
 // ---------------------------------------------------------------------------------------------
 // (c) odometry
 
-void odometry(Config c) {
+void odometry_bench(Config c) {
   if (c.scenarios.empty()) c.scenarios = {"64-32"};
   ulc_bench::Table table({"scenario", "mode", "threads", "pairs", "path_m", "end_drift_pct",
                           "segment_drift_pct", "rotation_drift_deg_per_100m", "pairs_per_s"});
@@ -609,24 +608,38 @@ void registration(Config c) {
 
 int main(int argc, char** argv) {
   Config c;
-  const bool repeats_given = std::any_of(
-      argv + 1, argv + argc, [](const char* a) { return std::string(a) == "--repeats"; });
-  ulc_bench::Args args;
+  CLI::App app(
+      "JEEP, scan-scan, odometry and ICP on simulated drives (modes: --accuracy "
+      "--separation --robustness --frames-sweep --odometry --registration; see the top "
+      "of bench/bench_jeep.cpp)",
+      "bench_jeep");
+  ulc_bench::add_options(app, c.bench);
   for (const char* mode :
        {"accuracy", "separation", "robustness", "odometry", "frames-sweep", "registration"})
-    args.flag(std::string("--") + mode, [&c, mode] { c.mode = mode; });
-  args.value("--scenarios", ulc_bench::list(c.scenarios))
-      .value("--starts", ulc_bench::at_least(c.starts, std::size_t{1}))
-      .value("--frames", ulc_bench::at_least(c.frames, std::size_t{1}))
-      .value("--seconds", ulc_bench::number(c.seconds))
-      .value("--seed", ulc_bench::at_least(c.seed, std::uint64_t{0}))
-      .value("--threads", ulc_bench::at_least(c.threads, 1))
-      .value("--cache", ulc_bench::text(c.cache))
-      .value("--png", ulc_bench::text(c.png_dir))
-      .flag("--one-way", [&] { c.one_way = true; });
-  c.bench = args.parse(argc, argv,
-                       "JEEP, scan-scan, odometry and ICP on simulated drives (modes: --accuracy "
-                       "--separation --robustness --frames-sweep --odometry --registration)");
+    app.add_flag_callback(
+        std::string("--") + mode, [&c, mode] { c.mode = mode; },
+        std::string("run the ") + mode + " bench (default: registration)");
+  app.add_option("--scenarios", c.scenarios, "scenarios (default: the mode's)")
+      ->delimiter(',')
+      ->type_name("A,B,...");
+  app.add_option("--starts", c.starts, "starts per scenario (default: the mode's)")
+      ->type_name("N")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--frames", c.frames, "frame pairs K (default 5)")
+      ->type_name("K")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--seconds", c.seconds, "simulated drive (default 20)")->type_name("S");
+  app.add_option("--seed", c.seed, "disturbance seed (default 1)")->type_name("N");
+  app.add_option("--threads", c.threads, "worker threads (default 2)")
+      ->type_name("N")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--cache", c.cache, "folder of the cached drives (default /tmp/ulc_jeep_cache)")
+      ->type_name("DIR");
+  app.add_option("--png", c.png_dir, "robustness and frames-sweep heat maps as PNG")
+      ->type_name("DIR");
+  app.add_flag("--one-way", c.one_way, "JEEP without its two-way step");
+  CLI11_PARSE(app, argc, argv);
+  const bool repeats_given = app.count("--repeats") > 0;
   if (c.mode == "accuracy") {
     accuracy(c);
   } else if (c.mode == "separation") {
@@ -637,7 +650,7 @@ int main(int argc, char** argv) {
     frames_sweep(c);
   } else if (c.mode == "odometry") {
     if (!repeats_given) c.bench.repeats = 1;  // a whole drive per repeat
-    odometry(c);
+    odometry_bench(c);
   } else {
     registration(c);
   }

@@ -34,7 +34,6 @@
 
 #include "../tests/jeep/jeep_test_util.hpp"
 #include "peers/peer_icp.hpp"
-#include "support/bench_args.hpp"
 #include "support/bench_util.hpp"
 #include "ulc/core/point_to_plane.hpp"
 #include "ulc/core/pose_error.hpp"
@@ -207,13 +206,17 @@ void run(const Config& c) {
 
 int main(int argc, char** argv) {
   Config c;
-  ulc_bench::Args args;
-  args.value("--seed", ulc_bench::at_least(c.seed, std::uint64_t{0}))
-      .value("--disturbances", ulc_bench::at_least(c.disturbances, std::size_t{1}))
-      .value("--threads", ulc_bench::at_least(c.threads, 1));
-  c.bench = args.parse(argc, argv,
-                       "point-to-plane ICP: ulc against PCL and Open3D (when built in) on the "
-                       "same clouds");
+  CLI::App app("point-to-plane ICP: ulc against PCL and Open3D (when built in) on the same clouds",
+               "bench_peers");
+  ulc_bench::add_options(app, c.bench);
+  app.add_option("--seed", c.seed, "disturbance seed (default 3)")->type_name("N");
+  app.add_option("--disturbances", c.disturbances, "disturbed starts (default 5)")
+      ->type_name("N")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--threads", c.threads, "worker threads (default 2)")
+      ->type_name("N")
+      ->check(CLI::PositiveNumber);
+  CLI11_PARSE(app, argc, argv);
   run(c);
   return 0;
 }

@@ -26,7 +26,6 @@
 #include <vector>
 
 #include "pipeline/rig.hpp"
-#include "support/bench_args.hpp"
 #include "support/bench_util.hpp"
 #include "ulc/core/pose_error.hpp"
 #include "ulc/sim/simulate.hpp"
@@ -177,19 +176,30 @@ void bench(const Config& c) {
 
 int main(int argc, char** argv) {
   Config c;
-  ulc_bench::Args args;
-  args.value("--scenarios", ulc_bench::list(c.scenarios))
-      .value("--seconds", ulc_bench::number(c.seconds))
-      .value("--stages", ulc_bench::text(c.stages))
-      .value("--decimation", ulc_bench::at_least(c.decimation, 1u))
-      .value("--seed", ulc_bench::at_least(c.seed, std::uint64_t{0}))
-      .value("--threads", ulc_bench::at_least(c.threads, 1))
-      .flag("--no-route", [&] { c.route = false; })
-      .flag("--no-cycles", [&] { c.cycles = false; })
-      .flag("--synced-clocks", [&] { c.synced_clocks = true; });
-  c.bench = args.parse(argc, argv,
-                       "whole rigs with no initial guess (options --scenarios --seconds --stages "
-                       "--decimation --seed --threads --no-route --no-cycles --synced-clocks)");
+  CLI::App app(
+      "whole simulated rigs calibrated with no initial guess (see the top of "
+      "bench/bench_rig.cpp)",
+      "bench_rig");
+  ulc_bench::add_options(app, c.bench);
+  app.add_option("--scenarios", c.scenarios, "scenarios (default ring-5x16,pitched-90,side-bpearl)")
+      ->delimiter(',')
+      ->type_name("A,B,...");
+  app.add_option("--seconds", c.seconds, "simulated drive (default 10)")->type_name("S");
+  app.add_option("--stages", c.stages, "the pairs' stages (default terra,jeep,hots)")
+      ->type_name("LIST");
+  app.add_option("--decimation", c.decimation, "keep every Nth point (default 1)")
+      ->type_name("N")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--seed", c.seed, "simulation seed (default 1)")->type_name("N");
+  app.add_option("--threads", c.threads, "worker threads (default 2)")
+      ->type_name("N")
+      ->check(CLI::PositiveNumber);
+  app.add_flag_callback(
+      "--no-route", [&] { c.route = false; }, "no routes through other targets");
+  app.add_flag_callback(
+      "--no-cycles", [&] { c.cycles = false; }, "no cycle checks");
+  app.add_flag("--synced-clocks", c.synced_clocks, "the pairs' clocks agree: no offset estimated");
+  CLI11_PARSE(app, argc, argv);
   bench(c);
   return 0;
 }

@@ -21,7 +21,6 @@
 #include <string>
 #include <vector>
 
-#include "support/bench_args.hpp"
 #include "support/bench_util.hpp"
 #include "ulc/sim/dataset_writer.hpp"
 #include "ulc/sim/simulate.hpp"
@@ -103,15 +102,14 @@ std::pair<double, double> wall_and_cpu(int repeats, F&& f) {
 int main(int argc, char** argv) {
   double seconds = 20.0;
   fs::path out_dir;
-  const bool repeats_given = std::any_of(
-      argv + 1, argv + argc, [](const char* a) { return std::strcmp(a, "--repeats") == 0; });
-  ulc_bench::Args args;
-  args.value("--seconds", ulc_bench::number(seconds)).value("--out", [&](const char* s) {
-    out_dir = s;
-  });
-  ulc_bench::Options options = args.parse(
-      argc, argv, "simulator speed: scenario 64-32 generated and written (--seconds S, --out DIR)");
-  if (!repeats_given) options.repeats = 3;
+  CLI::App app("simulator speed: scenario 64-32 generated and written", "bench_sim");
+  ulc_bench::Options options;
+  options.repeats = 3;
+  ulc_bench::add_options(app, options);
+  app.add_option("--seconds", seconds, "simulated drive (default 20)")->type_name("S");
+  app.add_option("--out", out_dir, "write the dataset here (default: a temporary folder)")
+      ->type_name("DIR");
+  CLI11_PARSE(app, argc, argv);
   const bool remove_out = out_dir.empty();
   if (out_dir.empty()) out_dir = fs::temp_directory_path() / "ulc_bench_sim";
 

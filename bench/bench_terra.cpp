@@ -32,6 +32,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <sstream>
 #include <string>
@@ -40,7 +41,6 @@
 
 #include "../tests/terra/terra_test_util.hpp"
 #include "pipeline/calibrate.hpp"
-#include "support/bench_args.hpp"
 #include "support/bench_util.hpp"
 #include "terra/terra.hpp"
 #include "ulc/core/pose_error.hpp"
@@ -470,7 +470,7 @@ struct MapsOptions {
   std::uint64_t seed = 1;
   unsigned decimation = 1;
   int threads = 2;
-  std::size_t below_mask = ulc::CalibrateOptions().terra_maps_below_mask;
+  std::size_t below_mask = ulc::CalibrateOptions().tuning.terra_source.maps_below_mask;
 };
 
 /// One start: the window's frames of each LiDAR from the start on (target turned by Q).
@@ -614,7 +614,9 @@ int run_maps(const ulc_bench::Options& options, const MapsOptions& mo) {
                     << (r.terra && r.terra->frames_mask_count
                             ? std::to_string(*r.terra->frames_mask_count)
                             : std::string("-"))
-                    << ", source " << (r.terra ? r.terra->source : std::string("-")) << ", map pts "
+                    << ", source "
+                    << (r.terra ? std::string(ulc::to_string(r.terra->source)) : std::string("-"))
+                    << ", map pts "
                     << (r.terra && r.terra->base_map ? r.terra->base_map->points : 0) << "/"
                     << (r.terra && r.terra->target_map ? r.terra->target_map->points : 0)
                     << ", odo "
@@ -661,40 +663,58 @@ int main(int argc, char** argv) {
   bool accuracy = false, maps = false;
   AccuracyOptions acc;
   MapsOptions mo;
-  bool pairs_given = false;
-  using ulc_bench::at_least;
-  using ulc_bench::number;
-  ulc_bench::Args args;
-  args.flag("--accuracy", [&] { accuracy = true; })
-      .flag("--maps", [&] { maps = true; })
-      .value("--starts", at_least(mo.starts, std::size_t{1}))
-      .value("--spacing", number(mo.spacing_s))
-      .value("--window", number(mo.window_s))
-      .value("--decimation", at_least(mo.decimation, 1u))
-      .value("--below-mask", at_least(mo.below_mask, std::size_t{0}))
-      .value("--pairs",
-             [&](const char* s) {
-               acc.pairs = ulc_bench::split_list(s);
-               pairs_given = true;
-             })
-      .value("--samples", at_least(acc.samples, std::size_t{1}))
-      .value("--seed", at_least(acc.seed, decltype(acc.seed){0}))
-      .value("--lattice", at_least(acc.lattice, std::size_t{2}))
-      .flag("--adaptive-d1", [&] { acc.adaptive_d1 = true; })
-      .flag("--no-adaptive-d1", [&] { acc.adaptive_d1 = false; })
-      .value("--min-overlap", number(acc.min_overlap))
-      .value("--top-k", at_least(acc.top_k, std::size_t{1}))
-      .value("--d1", number(acc.distance.d1))
-      .value("--d2", number(acc.distance.d2))
-      .value("--alpha", number(acc.distance.alpha))
-      .value("--coarse-stride", number(acc.coarse_stride_deg))
-      .value("--threads", at_least(acc.threads, 1));
-  const ulc_bench::Options options = args.parse(
-      argc, argv,
-      "TERRA speed (default) or accuracy against scancontext* (--accuracy [--pairs a,b] "
-      "[--samples 50] [--seed 1] [--lattice 10000] [--[no-]adaptive-d1] [--min-overlap 0.2] "
-      "[--threads 2]) or frames vs local maps (--maps [--pairs ...] [--starts 8] [--spacing 3] "
-      "[--window 2] [--decimation 1] [--below-mask 100] [--seed 1] [--threads 2])");
+  CLI::App app(
+      "TERRA speed (default), accuracy against scancontext* (--accuracy) or frames vs "
+      "local maps (--maps); see the top of bench/bench_terra.cpp",
+      "bench_terra");
+  ulc_bench::Options options;
+  ulc_bench::add_options(app, options);
+  app.add_flag("--accuracy", accuracy, "TERRA against scancontext* on simulated rig pairs");
+  app.add_flag("--maps", maps, "TERRA on frames against local maps");
+  app.add_option("--starts", mo.starts, "--maps: windows per pair (default 8)")
+      ->type_name("N")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--spacing", mo.spacing_s, "--maps: seconds between windows (default 3)")
+      ->type_name("S");
+  app.add_option("--window", mo.window_s, "--maps: seconds per window (default 2)")->type_name("S");
+  app.add_option("--decimation", mo.decimation, "--maps: keep every Nth point (default 1)")
+      ->type_name("N")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--below-mask", mo.below_mask,
+                 "--maps: local maps when the frame search overlaps in fewer cells (default 100)")
+      ->type_name("N");
+  auto* pairs_option = app.add_option("--pairs", acc.pairs, "pair scenarios (default: the mode's)")
+                           ->delimiter(',')
+                           ->type_name("A,B,...");
+  app.add_option("--samples", acc.samples, "--accuracy: frame pairs per scenario (default 50)")
+      ->type_name("N")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--seed", acc.seed, "seed (default 1)")->type_name("N");
+  app.add_option("--lattice", acc.lattice, "--accuracy: rotations of the lattice (default 10000)")
+      ->type_name("N")
+      ->check(CLI::Range(std::size_t{2}, std::numeric_limits<std::size_t>::max()));
+  app.add_flag_callback(
+      "--adaptive-d1", [&] { acc.adaptive_d1 = true; }, "--accuracy: adapt d1 (default)");
+  app.add_flag_callback(
+      "--no-adaptive-d1", [&] { acc.adaptive_d1 = false; }, "--accuracy: keep d1 fixed");
+  app.add_option("--min-overlap", acc.min_overlap,
+                 "--accuracy: minimum overlap ratio (default 0.2)")
+      ->type_name("X");
+  app.add_option("--top-k", acc.top_k, "--accuracy: hypotheses kept (default 10)")
+      ->type_name("K")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--d1", acc.distance.d1, "--accuracy: distance d1 (default 20)")->type_name("X");
+  app.add_option("--d2", acc.distance.d2, "--accuracy: distance d2 (default 5)")->type_name("X");
+  app.add_option("--alpha", acc.distance.alpha, "--accuracy: distance alpha (default 2)")
+      ->type_name("X");
+  app.add_option("--coarse-stride", acc.coarse_stride_deg,
+                 "--accuracy: coarse stride in degrees (default 10)")
+      ->type_name("DEG");
+  app.add_option("--threads", acc.threads, "worker threads (default 2)")
+      ->type_name("N")
+      ->check(CLI::PositiveNumber);
+  CLI11_PARSE(app, argc, argv);
+  const bool pairs_given = pairs_option->count() > 0;
   if (maps) {
     if (pairs_given) mo.pairs = acc.pairs;
     mo.seed = acc.seed;

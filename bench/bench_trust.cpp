@@ -29,7 +29,6 @@
 #include "odometry/run_odometry.hpp"
 #include "pipeline/calibrate.hpp"
 #include "pipeline/pipeline.hpp"
-#include "support/bench_args.hpp"
 #include "support/bench_util.hpp"
 #include "ulc/core/pose_error.hpp"
 
@@ -118,7 +117,7 @@ void bench(const Config& c) {
           const auto odo = odometry::run_odometry(a.frames, a.timestamps, b.frames, b.timestamps, C,
                                                   o.tuning.odometry);
           if (!ulc::calibrate_detail::odometry_usable(odo)) {
-            row.push_back(std::string("odometry_") + jeep::to_string(odo.status));
+            row.push_back(std::string("odometry_") + odometry::to_string(odo.status));
             for (int k = 0; k < 6; ++k) row.push_back("-");
             table.add_row(row);
             return;
@@ -185,15 +184,19 @@ void bench(const Config& c) {
 
 int main(int argc, char** argv) {
   Config c;
-  ulc_bench::Args args;
-  args.value("--scenarios", ulc_bench::list(c.scenarios))
-      .value("--seconds", ulc_bench::number(c.seconds))
-      .value("--runs", ulc_bench::at_least(c.runs, std::size_t{1}))
-      .value("--first-run", ulc_bench::at_least(c.first_run, std::size_t{0}))
-      .value("--threads", ulc_bench::at_least(c.threads, 1));
-  c.bench = args.parse(argc, argv,
-                       "JEEP and HOTS from right and wrong starts: does the cross-link rule tell "
-                       "them apart (options --scenarios --seconds --runs --first-run --threads)");
+  CLI::App app(
+      "JEEP and HOTS from right and wrong starts: does the cross-link rule tell them "
+      "apart",
+      "bench_trust");
+  ulc_bench::add_options(app, c.bench);
+  app.add_option("--scenarios", c.scenarios, "scenarios")->delimiter(',')->type_name("A,B,...");
+  app.add_option("--seconds", c.seconds, "simulated drive")->type_name("S");
+  app.add_option("--runs", c.runs, "runs per scenario")->type_name("N")->check(CLI::PositiveNumber);
+  app.add_option("--first-run", c.first_run, "first run's index (default 0)")->type_name("K");
+  app.add_option("--threads", c.threads, "worker threads (default 2)")
+      ->type_name("N")
+      ->check(CLI::PositiveNumber);
+  CLI11_PARSE(app, argc, argv);
   bench(c);
   return 0;
 }

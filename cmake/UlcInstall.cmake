@@ -12,6 +12,10 @@ install(EXPORT ulcTargets NAMESPACE ulc:: DESTINATION ${CMAKE_INSTALL_LIBDIR}/cm
 # the three core dependencies: find_package(ulc CONFIG REQUIRED COMPONENTS bags) -> ulc::bags.
 install(TARGETS ulc_bags EXPORT ulcBagsTargets)
 install(EXPORT ulcBagsTargets NAMESPACE ulc:: DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/ulc)
+# The same for ULC's own files (result file, ground_truth.json, YAML result): COMPONENTS results
+# -> ulc::results, with nlohmann_json and yaml-cpp.
+install(TARGETS ulc_results EXPORT ulcResultsTargets)
+install(EXPORT ulcResultsTargets NAMESPACE ulc:: DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/ulc)
 
 configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/ulcConfig.cmake.in
                               ${PROJECT_BINARY_DIR}/ulcConfig.cmake

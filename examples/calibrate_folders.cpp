@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "pipeline/calibrate.hpp"
-#include "pipeline/result_entry.hpp"
+#include "ulc/io/result_entry.hpp"
 #include "ulc/io/result_file.hpp"
 #include "ulc/io/sequence.hpp"
 #include "ulc/sim/dataset_writer.hpp"
@@ -68,7 +68,7 @@ int main(int argc, char** argv) {
     const Frames b = load_first(target, options.tuning.jeep.frames + 2);
     const ulc::PairCalibration c =
         ulc::calibrate_pair(a.clouds, a.times, b.clouds, b.times, options);
-    const ulc::io::PairResult entry = ulc::to_pair_result(c, base.name(), target.name());
+    const ulc::io::PairResult entry = ulc::io::to_pair_result(c, base.name(), target.name());
     ulc::io::write_result_file(output, {entry});
     const Eigen::Vector3d t = c.T_base_target.translation();
     std::printf("%s <- %s: %s %s\n  translation %.4f %.4f %.4f m\n  wrote %s\n",

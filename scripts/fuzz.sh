@@ -36,7 +36,8 @@ max_len_of() {
 
 install_missing() {
   local packages=(clang libclang-rt-14-dev cmake ninja-build pkg-config libeigen3-dev libtbb-dev
-    libnanoflann-dev libbz2-dev liblz4-dev libzstd-dev libsqlite3-dev libyaml-cpp-dev)
+    libnanoflann-dev libbz2-dev liblz4-dev libzstd-dev libsqlite3-dev libyaml-cpp-dev
+    nlohmann-json3-dev)
   local missing=() p
   for p in "${packages[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" ||

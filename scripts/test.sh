@@ -21,10 +21,11 @@ ctest --test-dir build --output-on-failure -j "$jobs"
 FUZZ_BUILD_JOBS=$jobs bash scripts/fuzz.sh 10
 
 # The parsers' and containers' tests again under AddressSanitizer and UndefinedBehaviorSanitizer,
-# in their own build folder: every reader of files and recordings, the JSON parser, the point
-# traits, kd-tree, voxels and parallel reduce. The algorithm folders (lie, registration, terra,
-# sim, jeep, hots, calibrate) and the app are left out for CI's time: each takes minutes to
-# compile under the sanitizers (add their names to `sanitized` to run them).
+# in their own build folder: every reader of files and recordings, of result files and ground
+# truth (tests/json), the point traits, kd-tree, voxels and parallel reduce. The algorithm
+# folders (lie, registration, terra, sim, jeep, hots, calibrate) and the app are left out for
+# CI's time: each takes minutes to compile under the sanitizers (add their names to `sanitized`
+# to run them).
 sanitized=(bag_messages core io json mcap ros1_bag rosbag2 spatial)
 cmake -S . -B build-sanitize -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DULC_ASSERTIONS=ON \
   -DULC_SANITIZE=ON -DULC_BUILD_TESTS=ON -DULC_BUILD_APPS=OFF -DULC_BUILD_BENCH=OFF \

@@ -8,8 +8,8 @@
 #include <cstddef>
 #include <string>
 
-#include "cli_args.hpp"
 #include "lidar_input.hpp"
+#include "usage_error.hpp"
 
 namespace ulc::app {
 
@@ -25,8 +25,8 @@ inline std::size_t covering_count(double base_period, double target_period,
 /// UsageError unless frame `index` was there to load.
 inline void require_frame(const LidarInput& input, const LoadedFrames& loaded, std::size_t index) {
   if (loaded.clouds.empty())
-    throw cli::UsageError("calibrate: --frame-index " + std::to_string(index) +
-                          " is past the last frame of " + input.source());
+    throw UsageError("calibrate: --frame-index " + std::to_string(index) +
+                     " is past the last frame of " + input.source());
 }
 
 }  // namespace ulc::app

@@ -13,15 +13,15 @@
 
 #include "calibrate_frames.hpp"
 #include "calibration_report.hpp"
-#include "cli_args.hpp"
+#include "command_line.hpp"
 #include "commands.hpp"
 #include "fused_cloud.hpp"
 #include "initial_extrinsic.hpp"
 #include "lidar_input.hpp"
 #include "pipeline/calibrate.hpp"
-#include "pipeline/result_entry.hpp"
 #include "pipeline/rig.hpp"
 #include "progress.hpp"
+#include "ulc/io/result_entry.hpp"
 #include "ulc/io/result_file.hpp"
 #include "ulc/io/result_yaml.hpp"
 
@@ -49,9 +49,9 @@ class StageProgress {
   std::unique_ptr<Progress> bar_;
 };
 
-std::vector<Stage> stages_option(const cli::Args& args) {
-  const ParsedStages parsed = parse_stages(args.get("stages", "terra,jeep,hots"));
-  if (!parsed.ok()) throw cli::UsageError("calibrate: option '--stages': " + parsed.error);
+std::vector<Stage> stages_option(const std::string& text) {
+  const ParsedStages parsed = parse_stages(text);
+  if (!parsed.ok()) throw UsageError("calibrate: option '--stages': " + parsed.error);
   return parsed.stages;
 }
 
@@ -60,7 +60,7 @@ void require_output_folder(const std::string& output) {
   const std::filesystem::path folder = std::filesystem::path(output).parent_path();
   std::error_code ec;
   if (!folder.empty() && !std::filesystem::is_directory(folder, ec))
-    throw cli::UsageError("calibrate: --output " + output + ": no such folder " + folder.string());
+    throw UsageError("calibrate: --output " + output + ": no such folder " + folder.string());
 }
 
 std::vector<Eigen::Vector3f> points_of(const PointCloud<float>& cloud) {
@@ -80,8 +80,8 @@ std::vector<Stage> cycle_stages(const std::vector<Stage>& stages) {
 /// The result-file entry of one target of the rig: its calibration, and for a routed target
 /// the LiDAR it went through and why the direct attempt failed.
 io::PairResult rig_entry(const RigTarget& t, const std::string& base, std::size_t frame_index) {
-  io::PairResult r = to_pair_result(t.result, base, t.name);
-  if (r.stages.find("terra")) r.stages["terra"]["frame_index"] = frame_index;
+  io::PairResult r = io::to_pair_result(t.result, base, t.name);
+  if (r.stages.contains("terra")) r.stages["terra"]["frame_index"] = frame_index;
   if (t.routed()) {
     r.via = t.via_name;
     r.direct_status = to_string(t.direct.status);
@@ -107,25 +107,25 @@ void print_summary(const io::PairResult& r) {
     std::printf("  route   %s <- %s <- %s (direct: %s)\n", r.base.c_str(), r.via.c_str(),
                 r.target.c_str(), r.direct_status.c_str());
   // TERRA's later hypotheses ran (calibrate.hpp): say which one the result comes from.
-  if (const io::Json* terra = r.stages.find("terra")) {
-    const io::Json* tried = terra->find("hypotheses");
+  if (const io::Json* terra = io::find_member(r.stages, "terra")) {
+    const io::Json* tried = io::find_member(*terra, "hypotheses");
     if (tried && tried->size() > 1)
       std::printf(
           "  terra   %zu hypotheses tried, the result from hypothesis %.0f "
           "(stages.terra.hypotheses)\n",
-          tried->size(), terra->at("hypothesis_used").as_number() + 1.0);
+          tried->size(), terra->at("hypothesis_used").get<double>() + 1.0);
   }
   const Eigen::Vector3d t = r.T_base_target.translation();
   const Eigen::Vector3d rpy = ulc::rpy_from_rotation(r.T_base_target.linear()) * kDeg;
   std::printf("  xyz_m   %9.4f %9.4f %9.4f\n", t.x(), t.y(), t.z());
   std::printf("  rpy_deg %9.3f %9.3f %9.3f\n", rpy.x(), rpy.y(), rpy.z());
-  if (const io::Json* hots = r.stages.find("hots");
-      hots && hots->at("status").as_string() != "skipped")
+  if (const io::Json* hots = io::find_member(r.stages, "hots");
+      hots && hots->at("status").get<std::string>() != "skipped")
     std::printf("  time_offset_ms %.2f\n", r.time_offset_s ? *r.time_offset_s * 1e3 : 0.0);
   std::printf("  time_s  terra %.2f  jeep %.2f  odometry %.2f  hots %.2f  total %.2f\n",
-              r.timing_s.at("terra").as_number(), r.timing_s.at("jeep").as_number(),
-              r.timing_s.at("odometry").as_number(), r.timing_s.at("hots").as_number(),
-              r.timing_s.at("total").as_number());
+              r.timing_s.at("terra").get<double>(), r.timing_s.at("jeep").get<double>(),
+              r.timing_s.at("odometry").get<double>(), r.timing_s.at("hots").get<double>(),
+              r.timing_s.at("total").get<double>());
 }
 
 void print_cycle(const io::CycleResult& c) {
@@ -142,89 +142,107 @@ void print_cycle(const io::CycleResult& c) {
 }  // namespace
 
 int run_calibrate(int argc, char** argv) {
-  cli::Args args("calibrate");
-  args.option("base", "SOURCE",
-              "the base LiDAR: a frame folder, a cloud file, or FILE:TOPIC of a recording (.bag, "
-              ".mcap, rosbag2 folder, .db3); add =NAME to name it",
-              true)
-      .option("target", "SOURCE", "a target LiDAR, as --base", true, true)
-      .option("output", "FILE", "write the result file (docs/design.md) here")
-      .option("format", "json|yaml",
-              "format of --output (default json; yaml adds ROS and URDF forms of each extrinsic)")
-      .option("merged-cloud", "PCD",
-              "write every LiDAR's first used frame in the base frame, one colour per LiDAR")
-      .option("report", "PNG", "draw the fused frames before (initial guess) and after calibration")
-      .option("stages", "LIST", "an ordered subset of terra,jeep,hots (default terra,jeep,hots)")
-      .option("initial", "GUESS",
-              "\"x y z roll pitch yaw\" (m, deg; R = Rz Ry Rx) or a result file; needed when "
-              "the stages skip terra")
-      .option("frame-index", "N", "TERRA's frame, and the first frame of JEEP and HOTS (default 0)")
-      .option("frames", "K", "frame pairs JEEP uses (default 5)")
-      .option("threads", "N", "worker threads (default: all cores)");
-  add_input_options(args);
-  args.flag("synced-clocks",
-            "the LiDARs' clocks are synchronised (PTP, GPS): HOTS estimates no clock offset "
-            "(for short drives that cannot pin one down)")
-      .flag("no-route",
-            "do not calibrate a failed target through another target that did calibrate")
-      .flag("no-cycles", "do not check the cycles base -> i -> j -> base (two targets or more)")
-      .flag("quiet", "no progress on stderr")
-      .flag("help", "show this help");
-  args.parse(argc, argv, 1);
-  if (args.has("help")) {
-    std::printf("%s",
-                args.help_text("Finds the extrinsic T_base_target of each target LiDAR "
-                               "against the base, with no initial guess (TERRA), "
-                               "refined (JEEP), then over every frame with the clock "
-                               "offset (odometry + HOTS). A target that fails against the base is "
-                               "calibrated through another target that succeeded (\"via\" in "
-                               "the result file); with two targets or more, each pair of "
-                               "targets is calibrated (terra,jeep) to report how far the cycle "
-                               "base -> i -> j -> base fails to close. Exit 0: every target "
-                               "calibrated, directly or through another; 1: some did not (the "
-                               "result file says why); 2: bad usage or input.")
-                    .c_str());
-    return kExitOk;
-  }
-
+  CLI::App app(
+      "Finds the extrinsic T_base_target of each target LiDAR against the base, with no initial "
+      "guess (TERRA), refined (JEEP), then over every frame with the clock offset (odometry + "
+      "HOTS). A target that fails against the base is calibrated through another target that "
+      "succeeded (\"via\" in the result file); with two targets or more, each pair of targets is "
+      "calibrated (terra,jeep) to report how far the cycle base -> i -> j -> base fails to close. "
+      "Exit 0: every target calibrated, directly or through another; 1: some did not (the result "
+      "file says why); 2: bad usage or input.",
+      "ulc calibrate");
+  std::string base_spec, output, format = "json", merged_cloud, report_png,
+                                 stages_text = "terra,jeep,hots", initial;
+  std::vector<std::string> target_specs;
+  long long frame_index_arg = 0, frames = 0, threads = 0;
+  bool synced_clocks = false, no_route = false, no_cycles = false, quiet = false;
   CalibrateOptions options;
-  options.stages = stages_option(args);
+  frames = static_cast<long long>(options.tuning.jeep.frames);
+  app.add_option(
+         "--base", base_spec,
+         "the base LiDAR: a frame folder, a cloud file, or FILE:TOPIC of a recording (.bag, "
+         ".mcap, rosbag2 folder, .db3); add =NAME to name it")
+      ->type_name("SOURCE")
+      ->required();
+  app.add_option("--target", target_specs, "a target LiDAR, as --base (repeatable)")
+      ->type_name("SOURCE")
+      ->required()
+      ->allow_extra_args(false);
+  auto* output_option =
+      app.add_option("--output", output, "write the result file (docs/design.md) here")
+          ->type_name("FILE");
+  app.add_option("--format", format,
+                 "format of --output (default json; yaml adds ROS and URDF forms of each "
+                 "extrinsic)")
+      ->check(CLI::IsMember({"json", "yaml"}));
+  auto* merged_option =
+      app.add_option("--merged-cloud", merged_cloud,
+                     "write every LiDAR's first used frame in the base frame, one colour per LiDAR")
+          ->type_name("PCD");
+  auto* report_option =
+      app.add_option("--report", report_png,
+                     "draw the fused frames before (initial guess) and after calibration")
+          ->type_name("PNG");
+  app.add_option("--stages", stages_text,
+                 "an ordered subset of terra,jeep,hots (default terra,jeep,hots)")
+      ->type_name("LIST");
+  auto* initial_option =
+      app.add_option("--initial", initial,
+                     "\"x y z roll pitch yaw\" (m, deg; R = Rz Ry Rx) or a result file; needed "
+                     "when the stages skip terra")
+          ->type_name("GUESS");
+  app.add_option("--frame-index", frame_index_arg,
+                 "TERRA's frame, and the first frame of JEEP and HOTS (default 0)")
+      ->type_name("N")
+      ->check(CLI::Range(0LL, 1000000000LL));
+  app.add_option("--frames", frames, "frame pairs JEEP uses (default 5)")
+      ->type_name("K")
+      ->check(CLI::Range(1LL, 100000LL));
+  auto* threads_option = app.add_option("--threads", threads, "worker threads (default: all cores)")
+                             ->type_name("N")
+                             ->check(CLI::Range(1LL, 1024LL));
+  InputArgs input_args;
+  add_input_options(app, input_args);
+  app.add_flag("--synced-clocks", synced_clocks,
+               "the LiDARs' clocks are synchronised (PTP, GPS): HOTS estimates no clock offset "
+               "(for short drives that cannot pin one down)");
+  app.add_flag("--no-route", no_route,
+               "do not calibrate a failed target through another target that did calibrate");
+  app.add_flag("--no-cycles", no_cycles,
+               "do not check the cycles base -> i -> j -> base (two targets or more)");
+  app.add_flag("--quiet", quiet, "no progress on stderr");
+  if (parse_command_line(app, "calibrate", argc, argv)) return kExitOk;
+
+  options.stages = stages_option(stages_text);
   const bool run_terra = has_stage(options.stages, Stage::terra);
   const bool run_jeep = has_stage(options.stages, Stage::jeep);
   const bool run_hots = has_stage(options.stages, Stage::hots);
-  if (run_terra && args.has("initial"))
-    throw cli::UsageError(
+  const bool has_initial = initial_option->count() > 0;
+  if (run_terra && has_initial)
+    throw UsageError(
         "calibrate: option '--initial' is only used when the stages skip terra (TERRA needs no "
         "guess); use --stages jeep,hots or hots with it");
-  if (!run_terra && !args.has("initial"))
-    throw cli::UsageError("calibrate: --stages " + stages_to_string(options.stages) +
-                          " needs an initial extrinsic: --initial \"x y z roll pitch yaw\" or "
-                          "--initial FILE.json");
-  if (args.has("synced-clocks")) options.time_offset_s = 0.0;
-  const auto frame_index =
-      static_cast<std::size_t>(args.get_int("frame-index", 0, 0, 1000000000LL));
-  options.tuning.jeep.frames = static_cast<std::size_t>(
-      args.get_int("frames", static_cast<long long>(options.tuning.jeep.frames), 1, 100000));
+  if (!run_terra && !has_initial)
+    throw UsageError("calibrate: --stages " + stages_to_string(options.stages) +
+                     " needs an initial extrinsic: --initial \"x y z roll pitch yaw\" or "
+                     "--initial FILE.json");
+  if (synced_clocks) options.time_offset_s = 0.0;
+  const auto frame_index = static_cast<std::size_t>(frame_index_arg);
+  options.tuning.jeep.frames = static_cast<std::size_t>(frames);
   std::optional<tbb::task_arena> arena;
-  if (args.has("threads")) arena.emplace(static_cast<int>(args.get_int("threads", 1, 1, 1024)));
-  if (!run_terra) (void)parse_initial(args.get("initial"), "", "");  // fail before any loading
-  const std::string format = args.get("format", "json");
-  if (format != "json" && format != "yaml")
-    throw cli::UsageError("calibrate: option '--format': expected json or yaml, got '" + format +
-                          "'");
-  for (const char* file_option : {"output", "merged-cloud", "report"})
-    if (args.has(file_option)) require_output_folder(args.get(file_option));
+  if (threads_option->count() > 0) arena.emplace(static_cast<int>(threads));
+  if (!run_terra) (void)parse_initial(initial, "", "");  // fail before any loading
+  for (const CLI::Option* file_option : {output_option, merged_option, report_option})
+    if (file_option->count() > 0) require_output_folder(file_option->as<std::string>());
 
-  std::vector<LidarSpec> specs{parse_lidar_spec(args.get("base"), "calibrate", "base")};
-  for (const auto& t : args.get_all("target"))
-    specs.push_back(parse_lidar_spec(t, "calibrate", "target"));
-  const auto inputs = open_lidar_inputs(specs, input_options(args, "calibrate"), "calibrate");
+  std::vector<LidarSpec> specs{parse_lidar_spec(base_spec, "calibrate", "base")};
+  for (const auto& t : target_specs) specs.push_back(parse_lidar_spec(t, "calibrate", "target"));
+  const auto inputs = open_lidar_inputs(specs, input_options(input_args, "calibrate"), "calibrate");
   print_input_warnings(inputs, "calibrate");
   const LidarInput& base = *inputs.front();
 
   // The frames each stage needs, counted from frame_index; the base's are shared by all targets.
   const std::size_t base_count = run_hots ? kAllFrames : run_jeep ? options.tuning.jeep.frames : 1;
-  const bool quiet = args.has("quiet");
   const LoadedFrames base_frames = base.load(frame_index, base_count);
   require_frame(base, base_frames, frame_index);
 
@@ -243,14 +261,14 @@ int run_calibrate(int argc, char** argv) {
   for (std::size_t k = 0; k + 1 < inputs.size(); ++k) {
     RigLidar<Frames> l{
         inputs[k + 1]->name(), &target_frames[k].clouds, &target_frames[k].times, {}};
-    if (!run_terra) l.initial = parse_initial(args.get("initial"), base.name(), l.name);
+    if (!run_terra) l.initial = parse_initial(initial, base.name(), l.name);
     lidars.push_back(std::move(l));
   }
   RigOptions rig_options;
   rig_options.pair = options;
   rig_options.pair.frame_index = 0;  // the loaded frames start at frame_index
-  rig_options.route = !args.has("no-route");
-  rig_options.cycles = !args.has("no-cycles") && inputs.size() >= 3;
+  rig_options.route = !no_route;
+  rig_options.cycles = !no_cycles && inputs.size() >= 3;
   rig_options.cycle_stages = cycle_stages(options.stages);
   StageProgress progress(quiet);
   rig_options.pair.progress = [&progress](const std::string& stage, double f) {
@@ -258,7 +276,7 @@ int run_calibrate(int argc, char** argv) {
   };
   auto run = [&] { return calibrate_rig(lidars, 0, rig_options); };
   const RigCalibration rig = arena ? arena->execute(run) : run();
-  if (rig.status == RigStatus::invalid_input) throw cli::UsageError("calibrate: " + rig.reason);
+  if (rig.status == RigStatus::invalid_input) throw UsageError("calibrate: " + rig.reason);
 
   std::vector<io::PairResult> results;
   std::vector<FusedPart> fused{{points_of(base_frames.clouds.front()), Isometry3d::Identity()}};
@@ -268,7 +286,7 @@ int run_calibrate(int argc, char** argv) {
     const RigTarget& t = rig.targets[k];
     results.push_back(rig_entry(t, base.name(), frame_index));
     print_summary(results.back());
-    if (args.has("merged-cloud") || args.has("report")) {
+    if (merged_option->count() > 0 || report_option->count() > 0) {
       // Pictures show the calibrated frames only when they are worth showing; a failed target is
       // drawn where its guess put it, in both panels.
       const Isometry3d before = lidars[t.lidar].initial.value_or(Isometry3d::Identity());
@@ -283,20 +301,20 @@ int run_calibrate(int argc, char** argv) {
     print_cycle(cycles.back());
   }
 
-  if (args.has("output")) {
+  if (output_option->count() > 0) {
     if (format == "yaml")
-      io::write_result_yaml(args.get("output"), results, cycles);
+      io::write_result_yaml(output, results, cycles);
     else
-      io::write_result_file(args.get("output"), results, cycles);
-    std::printf("wrote %s\n", args.get("output").c_str());
+      io::write_result_file(output, results, cycles);
+    std::printf("wrote %s\n", output.c_str());
   }
-  if (args.has("merged-cloud")) {
-    write_fused_cloud(args.get("merged-cloud"), fused);
-    std::printf("wrote %s\n", args.get("merged-cloud").c_str());
+  if (merged_option->count() > 0) {
+    write_fused_cloud(merged_cloud, fused);
+    std::printf("wrote %s\n", merged_cloud.c_str());
   }
-  if (args.has("report")) {
-    write_calibration_report(args.get("report"), report);
-    std::printf("wrote %s\n", args.get("report").c_str());
+  if (report_option->count() > 0) {
+    write_calibration_report(report_png, report);
+    std::printf("wrote %s\n", report_png.c_str());
   }
   for (const auto& r : results)
     if (!r.success) return kExitFailed;

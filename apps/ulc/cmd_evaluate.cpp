@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "cli_args.hpp"
+#include "command_line.hpp"
 #include "commands.hpp"
 #include "ulc/core/pose_error.hpp"
 #include "ulc/io/ground_truth.hpp"
@@ -52,21 +52,23 @@ PairEvaluation evaluate_pair(const io::PairResult& r, const io::GroundTruth& gt)
 }  // namespace
 
 int run_evaluate(int argc, char** argv) {
-  cli::Args args("evaluate");
-  args.option("result", "FILE", "result file written by `ulc calibrate --output`", true)
-      .option("ground-truth", "FILE", "the dataset's ground_truth.json", true)
-      .flag("json", "print JSON instead of a table")
-      .flag("help", "show this help");
-  args.parse(argc, argv, 1);
-  if (args.has("help")) {
-    std::printf("%s", args.help_text("Compares a result file with the ground truth: e_rot (deg), "
-                                     "e_trans (m), time-offset error, success.")
-                          .c_str());
-    return kExitOk;
-  }
-  const io::ResultDocument file = io::read_result_document(args.get("result"));
+  CLI::App app(
+      "Compares a result file with the ground truth: e_rot (deg), e_trans (m), time-offset "
+      "error, success.",
+      "ulc evaluate");
+  std::string result_path, truth_path;
+  bool json = false;
+  app.add_option("--result", result_path, "result file written by `ulc calibrate --output`")
+      ->type_name("FILE")
+      ->required();
+  app.add_option("--ground-truth", truth_path, "the dataset's ground_truth.json")
+      ->type_name("FILE")
+      ->required();
+  app.add_flag("--json", json, "print JSON instead of a table");
+  if (parse_command_line(app, "evaluate", argc, argv)) return kExitOk;
+  const io::ResultDocument file = io::read_result_document(result_path);
   const std::vector<io::PairResult>& results = file.results;
-  const auto gt = io::read_ground_truth(args.get("ground-truth"));
+  const auto gt = io::read_ground_truth(truth_path);
 
   io::Json pairs = io::Json::array();
   int failures = 0;
@@ -88,31 +90,32 @@ int run_evaluate(int argc, char** argv) {
   }
   io::Json cycles = io::Json::array();
   for (const auto& c : file.cycles) cycles.push_back(io::to_json(c));
-  if (args.has("json")) {
+  if (json) {
     io::Json doc = io::Json::object();
     doc["pairs"] = std::move(pairs);
     if (!file.cycles.empty()) doc["cycles"] = std::move(cycles);
     doc["success_criterion"] = "e_rot < 1 deg and e_trans < 0.1 m";
-    std::printf("%s\n", doc.dump(1).c_str());
+    std::printf("%s\n", io::dump_json(doc).c_str());
   } else {
     std::printf("%-12s %-12s %10s %10s %12s  %s\n", "base", "target", "e_rot_deg", "e_trans_m",
                 "dt_error_ms", "success");
-    for (const auto& e : pairs.as_array()) {
+    for (const auto& e : pairs) {
       auto num = [](const io::Json& j, double scale, const char* fmt) {
         char buf[32];
         if (!j.is_number()) return std::string("-");
-        std::snprintf(buf, sizeof buf, fmt, j.as_number() * scale);
+        std::snprintf(buf, sizeof buf, fmt, j.get<double>() * scale);
         return std::string(buf);
       };
-      const io::Json* via = e.find("via");
-      std::printf("%-12s %-12s %10s %10s %12s  %s%s%s\n", e.at("base").as_string().c_str(),
-                  e.at("target").as_string().c_str(), num(e.at("e_rot_deg"), 1, "%.4f").c_str(),
+      const io::Json* via = io::find_member(e, "via");
+      std::printf("%-12s %-12s %10s %10s %12s  %s%s%s\n", e.at("base").get<std::string>().c_str(),
+                  e.at("target").get<std::string>().c_str(),
+                  num(e.at("e_rot_deg"), 1, "%.4f").c_str(),
                   num(e.at("e_trans_m"), 1, "%.4f").c_str(),
                   num(e.at("time_offset_error_s"), 1000, "%.2f").c_str(),
-                  !e.at("ground_truth_found").as_bool() ? "no ground truth"
-                  : e.at("success").as_bool()           ? "yes"
-                                                        : "no",
-                  via ? " (via " : "", via ? (via->as_string() + ")").c_str() : "");
+                  !e.at("ground_truth_found").get<bool>() ? "no ground truth"
+                  : e.at("success").get<bool>()           ? "yes"
+                                                          : "no",
+                  via ? " (via " : "", via ? (via->get<std::string>() + ")").c_str() : "");
     }
     std::printf("success: e_rot < 1 deg and e_trans < 0.1 m (and the calibration said ok)\n");
     for (const auto& c : file.cycles) {

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "cli_args.hpp"
+#include "command_line.hpp"
 #include "commands.hpp"
 #include "lidar_input.hpp"
 #include "ulc/io/pcd.hpp"
@@ -60,51 +60,43 @@ std::size_t export_lidar(const LidarInput& input, const fs::path& dir) {
 }  // namespace
 
 int run_export(int argc, char** argv) {
-  cli::Args args("export");
-  args.option("source", "SOURCE",
-              "a LiDAR: FILE:TOPIC of a recording (.bag, .mcap, rosbag2 folder, .db3), a frame "
-              "folder or a cloud file; =NAME names its folder",
-              true, true)
-      .option("out", "DIR", "the dataset folder to write (created if needed)", true)
-      .flag("help", "show this help");
-  add_input_options(args);
-  // `ulc export SOURCE... DIR` reads better than --source/--out: accept positional arguments.
-  std::vector<std::string> words;
-  std::vector<char*> rewritten{argv[0]};
-  std::vector<std::string> positional;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a.rfind("--", 0) == 0) {
-      rewritten.push_back(argv[i]);
-      const bool takes_value = a.find('=') == std::string::npos && a != "--help";
-      if (takes_value && i + 1 < argc) rewritten.push_back(argv[++i]);
-    } else {
-      positional.push_back(a);
-    }
+  CLI::App app(
+      "Writes LiDARs as the dataset folder ULC and other tools read: DIR/<lidar>/000000.pcd ... "
+      "and timestamps.txt. Usage: ulc export drive.bag:/velodyne_points DIR",
+      "ulc export");
+  std::vector<std::string> words, sources;
+  std::string out_dir;
+  // `ulc export SOURCE... DIR` reads better than --source/--out: both are accepted.
+  app.add_option("sources", words,
+                 "the LiDARs (as --source), then the dataset folder DIR unless --out names it")
+      ->type_name("SOURCE");
+  app.add_option("--source", sources,
+                 "a LiDAR: FILE:TOPIC of a recording (.bag, .mcap, rosbag2 folder, .db3), a frame "
+                 "folder or a cloud file; =NAME names its folder (repeatable)")
+      ->type_name("SOURCE")
+      ->allow_extra_args(false);
+  auto* out_option =
+      app.add_option("--out", out_dir, "the dataset folder to write (created if needed)")
+          ->type_name("DIR");
+  InputArgs input_args;
+  add_input_options(app, input_args);
+  if (parse_command_line(app, "export", argc, argv)) return kExitOk;
+  if (out_option->count() == 0) {
+    if (words.empty())
+      throw UsageError(
+          "export: the dataset folder is missing: ulc export SOURCE... DIR (or --out "
+          "DIR)");
+    out_dir = words.back();
+    words.pop_back();
   }
-  if (!positional.empty()) {
-    words.reserve(2 * positional.size());
-    for (std::size_t k = 0; k < positional.size(); ++k) {
-      words.push_back(k + 1 == positional.size() ? "--out" : "--source");
-      words.push_back(positional[k]);
-    }
-    for (auto& w : words) rewritten.push_back(w.data());
-  }
-  args.parse(static_cast<int>(rewritten.size()), rewritten.data(), 1);
-  if (args.has("help")) {
-    std::printf("%s",
-                args.help_text("Writes LiDARs as the dataset folder ULC and other tools read: "
-                               "DIR/<lidar>/000000.pcd ... and timestamps.txt. Usage: ulc "
-                               "export drive.bag:/velodyne_points DIR")
-                    .c_str());
-    return kExitOk;
-  }
+  sources.insert(sources.end(), words.begin(), words.end());
+  if (sources.empty())
+    throw UsageError("export: no LiDAR to export: ulc export SOURCE... DIR (or --source SOURCE)");
   std::vector<LidarSpec> specs;
-  for (const auto& s : args.get_all("source"))
-    specs.push_back(parse_lidar_spec(s, "export", "source"));
-  const auto inputs = open_lidar_inputs(specs, input_options(args, "export"), "export");
+  for (const auto& s : sources) specs.push_back(parse_lidar_spec(s, "export", "source"));
+  const auto inputs = open_lidar_inputs(specs, input_options(input_args, "export"), "export");
   print_input_warnings(inputs, "export");
-  const fs::path out = args.get("out");
+  const fs::path out = out_dir;
   for (const auto& input : inputs) {
     const fs::path dir = out / folder_name(input->name());
     const std::size_t n = export_lidar(*input, dir);

@@ -10,7 +10,7 @@
 #include <limits>
 #include <string>
 
-#include "cli_args.hpp"
+#include "command_line.hpp"
 #include "commands.hpp"
 #include "lidar_input.hpp"
 #include "ulc/bags/cloud_topic.hpp"
@@ -68,10 +68,18 @@ void print_cloud(const io::DecodedCloud& c, const io::ReadStats& s, const std::s
   }
 }
 
-int inspect_folder(const std::string& path, const cli::Args& args) {
+/// Frame `index` of `count`, else UsageError.
+std::size_t frame_index(long long index, std::size_t count) {
+  if (index >= static_cast<long long>(count))
+    throw UsageError("inspect: option '--frame-index' must be within [0, " +
+                     std::to_string(count == 0 ? 0 : count - 1) + "], got " +
+                     std::to_string(index));
+  return static_cast<std::size_t>(index);
+}
+
+int inspect_folder(const std::string& path, long long frame_index_arg) {
   const io::Sequence seq(path);
-  const auto index = static_cast<std::size_t>(
-      args.get_int("frame-index", 0, 0, static_cast<long long>(seq.size()) - 1));
+  const std::size_t index = frame_index(frame_index_arg, seq.size());
   std::printf("%s: %zu frame%s, frame times from %s\n", path.c_str(), seq.size(),
               seq.size() == 1 ? "" : "s", time_source_name(seq.time_source()));
   if (seq.size() > 1) {
@@ -127,7 +135,7 @@ int inspect_recording(const std::string& path) {
   return kExitOk;
 }
 
-int inspect_topic(const LidarSpec& spec, const cli::Args& args, const InputOptions& options) {
+int inspect_topic(const LidarSpec& spec, long long frame_index_arg, const InputOptions& options) {
   const auto rec = bags::open_recording(spec.path);
   print_warnings(*rec);
   const bags::CloudTopic topic(*rec, spec.topic, spec.path,
@@ -135,8 +143,8 @@ int inspect_topic(const LidarSpec& spec, const cli::Args& args, const InputOptio
                                    ? bags::FrameTime::receive_time
                                    : bags::FrameTime::header_stamp);
   const auto& info = topic.info();
-  const auto index = static_cast<std::size_t>(
-      args.get_int("frame-index", 0, 0, std::max<long long>(0, info.message_count - 1)));
+  const std::size_t index = frame_index(
+      frame_index_arg, std::max<std::size_t>(1, static_cast<std::size_t>(info.message_count)));
   std::printf(
       "%s:%s: %s, %llu message%s, %s\n", spec.path.c_str(), info.name.c_str(), info.type.c_str(),
       static_cast<unsigned long long>(info.message_count), info.message_count == 1 ? "" : "s",
@@ -151,7 +159,7 @@ int inspect_topic(const LidarSpec& spec, const cli::Args& args, const InputOptio
   bags::TopicFrame f;
   for (std::size_t k = 0; k <= index; ++k)
     if (!frames.next(f))
-      throw cli::UsageError("inspect: the topic has no message " + std::to_string(index));
+      throw UsageError("inspect: the topic has no message " + std::to_string(index));
   std::printf("  frame:       %zu, frame_id '%s'\n", index, f.message.header.frame_id.c_str());
   print_cloud(f.message.cloud, f.message.stats, bags::describe(f.message.time), f.timestamp);
   return kExitOk;
@@ -160,32 +168,29 @@ int inspect_topic(const LidarSpec& spec, const cli::Args& args, const InputOptio
 }  // namespace
 
 int run_inspect(int argc, char** argv) {
-  cli::Args args("inspect");
-  args.option("path", "PATH",
-              "a cloud file (.pcd .ply .bin), a LiDAR's frame folder, a recording (.bag .mcap "
-              ".db3, rosbag2 folder) or FILE:TOPIC",
-              true)
-      .option("frame-index", "N", "which frame of a folder or topic to describe (default 0)")
-      .option("frame-time", "header|receive",
-              "recordings: a frame's time is its header.stamp (header, default) or the time the "
-              "recorder received it (receive)")
-      .flag("help", "show this help");
-  // `ulc inspect PATH` reads better than `--path PATH`: accept one positional argument.
-  std::vector<char*> rewritten(argv, argv + argc);
-  std::string path_flag = "--path";
-  if (argc >= 2 && std::string(argv[1]).rfind("--", 0) != 0)
-    rewritten.insert(rewritten.begin() + 1, path_flag.data());
-  args.parse(static_cast<int>(rewritten.size()), rewritten.data(), 1);
-  if (args.has("help")) {
-    std::printf("%s", args.help_text("Describes a cloud file, a frame folder, a recording's "
-                                     "topics, or the clouds of FILE:TOPIC.")
-                          .c_str());
-    return kExitOk;
-  }
-  const LidarSpec spec = parse_lidar_spec(args.get("path"), "inspect", "path");
-  if (!spec.topic.empty()) return inspect_topic(spec, args, input_options(args, "inspect"));
+  CLI::App app(
+      "Describes a cloud file, a frame folder, a recording's topics, or the clouds of FILE:TOPIC.",
+      "ulc inspect");
+  std::string path;
+  long long frame_index_arg = 0;
+  // `ulc inspect PATH` reads better than `--path PATH`: both are accepted.
+  app.add_option("path,--path", path,
+                 "a cloud file (.pcd .ply .bin), a LiDAR's frame folder, a recording (.bag .mcap "
+                 ".db3, rosbag2 folder) or FILE:TOPIC")
+      ->type_name("PATH")
+      ->required();
+  app.add_option("--frame-index", frame_index_arg,
+                 "which frame of a folder or topic to describe (default 0)")
+      ->type_name("N")
+      ->check(CLI::NonNegativeNumber);
+  InputArgs input_args;
+  add_frame_time_option(app, input_args);
+  if (parse_command_line(app, "inspect", argc, argv)) return kExitOk;
+  const LidarSpec spec = parse_lidar_spec(path, "inspect", "path");
+  if (!spec.topic.empty())
+    return inspect_topic(spec, frame_index_arg, input_options(input_args, "inspect"));
   if (bags::is_recording_path(spec.path)) return inspect_recording(spec.path);
-  return inspect_folder(spec.path, args);
+  return inspect_folder(spec.path, frame_index_arg);
 }
 
 }  // namespace ulc::app

@@ -5,7 +5,7 @@
 #include <filesystem>
 #include <string>
 
-#include "cli_args.hpp"
+#include "command_line.hpp"
 #include "commands.hpp"
 #include "progress.hpp"
 #include "top_down_image.hpp"
@@ -73,65 +73,81 @@ void print_scenarios() {
 }  // namespace
 
 int run_simulate(int argc, char** argv) {
-  cli::Args args("simulate");
-  args.option("scenario", "NAME", "a rig and scene (see --list)")
-      .option("out", "DIR", "dataset folder to write")
-      .option("seconds", "S", "recorded duration (default 20)")
-      .option("seed", "N", "seed of scene, route, phases and noise (default 1)")
-      .option("rate", "HZ", "frame rate of every LiDAR (default: the scenario's)")
-      .option("time-offset", "S", "clock offset of every target: t_base_clock = t_target_clock + S")
-      .option("steering-ramp", "M",
-              "the vehicle follows its route averaged over M metres, so that yaw rate and body "
-              "roll ramp into turns (default 0: they step where a street meets a corner arc)")
-      .option("preview", "PNG", "also draw every LiDAR's first frame, top-down and side")
-      .flag("list", "list the scenarios and exit")
-      .flag("quiet", "no progress on stderr")
-      .flag("help", "show this help");
-  args.parse(argc, argv, 1);
-  if (args.has("help")) {
-    std::printf("%s", args.help_text("Simulates a multi-LiDAR rig driving through a scene and "
-                                     "writes a dataset folder with exact ground truth.")
-                          .c_str());
-    return kExitOk;
-  }
-  if (args.has("list")) {
+  CLI::App app(
+      "Simulates a multi-LiDAR rig driving through a scene and writes a dataset folder with exact "
+      "ground truth.",
+      "ulc simulate");
+  std::string scenario_name, out_dir, preview;
+  double seconds = 20.0, rate = 10.0, time_offset = 0.0, steering_ramp = 0.0;
+  long long seed = 1;
+  bool list = false, quiet = false;
+  // --scenario and --out are required unless --list: checked after parsing.
+  auto* scenario_option =
+      app.add_option("--scenario", scenario_name, "a rig and scene (see --list)")
+          ->type_name("NAME");
+  auto* out_option = app.add_option("--out", out_dir, "dataset folder to write")->type_name("DIR");
+  app.add_option("--seconds", seconds, "recorded duration, (0, 3600] s (default 20)")
+      ->type_name("S");
+  app.add_option("--seed", seed, "seed of scene, route, phases and noise (default 1)")
+      ->type_name("N")
+      ->check(CLI::Range(0LL, 1LL << 62));
+  auto* rate_option =
+      app.add_option("--rate", rate,
+                     "frame rate of every LiDAR, [1, 100] Hz (default: the scenario's)")
+          ->type_name("HZ");
+  auto* offset_option =
+      app.add_option("--time-offset", time_offset,
+                     "clock offset of every target, [-1, 1] s: t_base_clock = t_target_clock + S")
+          ->type_name("S");
+  auto* ramp_option =
+      app.add_option(
+             "--steering-ramp", steering_ramp,
+             "the vehicle follows its route averaged over M metres ([0, 50]), so that yaw rate and "
+             "body roll ramp into turns (default 0: they step where a street meets a "
+             "corner arc)")
+          ->type_name("M");
+  auto* preview_option =
+      app.add_option("--preview", preview, "also draw every LiDAR's first frame, top-down and side")
+          ->type_name("PNG");
+  app.add_flag("--list", list, "list the scenarios and exit");
+  app.add_flag("--quiet", quiet, "no progress on stderr");
+  if (parse_command_line(app, "simulate", argc, argv)) return kExitOk;
+  if (list) {
     print_scenarios();
     return kExitOk;
   }
-  if (!args.has("scenario"))
-    throw cli::UsageError("simulate: missing required option '--scenario NAME' (see --list)");
-  if (!args.has("out")) throw cli::UsageError("simulate: missing required option '--out DIR'");
-  auto spec = sim::scenario(args.get("scenario"));
+  if (scenario_option->count() == 0)
+    throw UsageError("simulate: --scenario is required (see --list)");
+  if (out_option->count() == 0) throw UsageError("simulate: --out is required");
+  auto spec = sim::scenario(scenario_name);
   if (!spec)
-    throw cli::UsageError("simulate: unknown scenario '" + args.get("scenario") +
-                          "' (see `ulc simulate --list`)");
-  if (args.has("steering-ramp")) {
-    const double ramp = args.get_double("steering-ramp", 0.0);
-    if (!(ramp >= 0.0 && ramp <= 50.0))
-      throw cli::UsageError("simulate: option '--steering-ramp' must be in [0, 50] m");
-    spec->motion.steering_ramp_m = ramp;
+    throw UsageError("simulate: unknown scenario '" + scenario_name +
+                     "' (see `ulc simulate --list`)");
+  // The numbers' ranges are checked here (CLI::Range would let NaN through).
+  if (ramp_option->count() > 0) {
+    if (!(steering_ramp >= 0.0 && steering_ramp <= 50.0))
+      throw UsageError("simulate: option '--steering-ramp' must be in [0, 50] m");
+    spec->motion.steering_ramp_m = steering_ramp;
   }
   sim::SimulationOptions options;
-  options.seconds = args.get_double("seconds", 20.0);
+  options.seconds = seconds;
   if (!(options.seconds > 0 && options.seconds <= 3600))
-    throw cli::UsageError("simulate: option '--seconds' must be in (0, 3600]");
-  options.seed = static_cast<std::uint64_t>(args.get_int("seed", 1, 0, (1LL << 62)));
-  if (args.has("rate")) {
-    const double rate = args.get_double("rate", 10.0);
+    throw UsageError("simulate: option '--seconds' must be in (0, 3600]");
+  options.seed = static_cast<std::uint64_t>(seed);
+  if (rate_option->count() > 0) {
     if (!(rate >= 1 && rate <= 100))
-      throw cli::UsageError("simulate: option '--rate' must be in [1, 100] Hz");
+      throw UsageError("simulate: option '--rate' must be in [1, 100] Hz");
     options.rate_hz = rate;
   }
-  if (args.has("time-offset")) {
-    const double offset = args.get_double("time-offset", 0.0);
-    if (!(std::fabs(offset) <= 1.0))
-      throw cli::UsageError("simulate: option '--time-offset' must be within [-1, 1] s");
-    options.target_clock_offset_s = offset;
+  if (offset_option->count() > 0) {
+    if (!(std::fabs(time_offset) <= 1.0))
+      throw UsageError("simulate: option '--time-offset' must be within [-1, 1] s");
+    options.target_clock_offset_s = time_offset;
   }
   options.keep_frames = false;
 
-  const std::filesystem::path out = args.get("out");
-  Progress progress("simulate", args.has("quiet"));
+  const std::filesystem::path out = out_dir;
+  Progress progress("simulate", quiet);
   const auto result = sim::simulate_to_directory(
       out, *spec, options,
       [&](std::size_t done, std::size_t total) { progress.update(done, total); });
@@ -146,9 +162,9 @@ int run_simulate(int argc, char** argv) {
                 l.name.c_str(), l.model.c_str(), l.timestamps.size(), l.rate_hz, l.points,
                 l.clock_offset_s);
   std::printf("  ground truth: %s\n", (out / "ground_truth.json").string().c_str());
-  if (args.has("preview")) {
-    write_preview(args.get("preview"), out, result.dataset);
-    std::printf("  preview: %s\n", args.get("preview").c_str());
+  if (preview_option->count() > 0) {
+    write_preview(preview, out, result.dataset);
+    std::printf("  preview: %s\n", preview.c_str());
   }
   return kExitOk;
 }

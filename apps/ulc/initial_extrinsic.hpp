@@ -13,9 +13,9 @@
 #include <string>
 #include <vector>
 
-#include "cli_args.hpp"
 #include "ulc/core/lie.hpp"
 #include "ulc/io/result_file.hpp"
+#include "usage_error.hpp"
 
 namespace ulc::app {
 
@@ -44,7 +44,7 @@ inline Eigen::Isometry3d parse_initial_numbers(const std::string& text) {
     v.push_back(x);
   }
   if (v.size() != 6)
-    throw cli::UsageError(
+    throw UsageError(
         "calibrate: option '--initial' expects \"x y z roll pitch yaw\" (metres, degrees) or a "
         "result file (.json), got '" +
         text + "'");
@@ -61,7 +61,7 @@ inline Eigen::Isometry3d parse_initial(const std::string& text, const std::strin
   if (!initial_is_file(text)) return parse_initial_numbers(text);
   const std::vector<io::PairResult> results = io::read_result_file(text);
   if (results.empty())
-    throw cli::UsageError("calibrate: --initial " + text + ": the result file has no entry");
+    throw UsageError("calibrate: --initial " + text + ": the result file has no entry");
   for (const auto& r : results)
     if (r.base == base && r.target == target) return r.T_base_target;
   return results.front().T_base_target;

@@ -9,7 +9,7 @@
 #include <map>
 #include <set>
 
-#include "cli_args.hpp"
+#include "command_line.hpp"
 #include "odometry/frame_pairing.hpp"
 #include "ulc/bags/cloud_topic.hpp"
 #include "ulc/bags/recording.hpp"
@@ -107,9 +107,8 @@ std::string topic_of(const LidarSpec& spec, const Recording& rec, const std::str
   if (!spec.topic.empty()) return spec.topic;
   const auto clouds = bags::cloud_topics(*rec.source);
   if (clouds.size() == 1) return clouds.front().name;
-  throw cli::UsageError(
-      command + ": '" + spec.text + "': name the LiDAR's topic as " + spec.path +
-      ":TOPIC; its point-cloud topics: " + bags::describe_cloud_topics(*rec.source));
+  throw UsageError(command + ": '" + spec.text + "': name the LiDAR's topic as " + spec.path +
+                   ":TOPIC; its point-cloud topics: " + bags::describe_cloud_topics(*rec.source));
 }
 
 class TopicInput : public LidarInput {
@@ -195,40 +194,46 @@ void require_unique_names(const std::vector<std::unique_ptr<LidarInput>>& inputs
   std::set<std::string> names;
   for (const auto& in : inputs)
     if (!names.insert(in->name()).second)
-      throw cli::UsageError(command + ": two LiDARs are named '" + in->name() + "' (" +
-                            in->source() + "); name them explicitly: PATH=NAME");
+      throw UsageError(command + ": two LiDARs are named '" + in->name() + "' (" + in->source() +
+                       "); name them explicitly: PATH=NAME");
 }
 
-double non_negative(const cli::Args& args, const char* name, const std::string& command) {
-  const double v = args.get_double(name, 0.0);
+double non_negative(double v, const char* name, const std::string& command) {
   if (!(v >= 0.0 && std::isfinite(v)))
-    throw cli::UsageError(command + ": option '--" + name + "' must be a number >= 0");
+    throw UsageError(command + ": option '--" + name + "' must be a number >= 0");
   return v;
 }
 
 }  // namespace
 
-void add_input_options(cli::Args& args) {
-  args.option("start", "S", "use the frames from S seconds after the recording's first message")
-      .option("duration", "D", "use D seconds of frames (from --start)")
-      .option("frame-time", "header|receive",
-              "recordings: a frame's time is its header.stamp (header, default) or the time the "
-              "recorder received it (receive)");
+void add_frame_time_option(CLI::App& app, InputArgs& args) {
+  app.add_option("--frame-time", args.frame_time,
+                 "recordings: a frame's time is its header.stamp (header, default) or the time the "
+                 "recorder received it (receive)")
+      ->check(CLI::IsMember({"header", "receive"}));
 }
 
-InputOptions input_options(const cli::Args& args, const std::string& command) {
+void add_input_options(CLI::App& app, InputArgs& args) {
+  args.start = app.add_option("--start", args.start_s,
+                              "use the frames from S seconds after the recording's first message")
+                   ->type_name("S");
+  args.duration =
+      app.add_option("--duration", args.duration_s, "use D seconds of frames (from --start)")
+          ->type_name("D");
+  add_frame_time_option(app, args);
+}
+
+InputOptions input_options(const InputArgs& args, const std::string& command) {
   InputOptions o;
-  if (args.has("start")) o.window.start_s = non_negative(args, "start", command);
-  if (args.has("duration")) {
-    o.window.duration_s = non_negative(args, "duration", command);
+  if (args.start && args.start->count() > 0)
+    o.window.start_s = non_negative(args.start_s, "start", command);
+  if (args.duration && args.duration->count() > 0) {
+    o.window.duration_s = non_negative(args.duration_s, "duration", command);
     if (*o.window.duration_s <= 0.0)
-      throw cli::UsageError(command + ": option '--duration' must be more than 0 seconds");
+      throw UsageError(command + ": option '--duration' must be more than 0 seconds");
   }
-  const std::string t = args.get("frame-time", "header");
-  if (t != "header" && t != "receive")
-    throw cli::UsageError(command + ": option '--frame-time': expected header or receive, got '" +
-                          t + "'");
-  o.frame_time = t == "receive" ? FrameTimeChoice::receive_time : FrameTimeChoice::header_stamp;
+  o.frame_time =
+      args.frame_time == "receive" ? FrameTimeChoice::receive_time : FrameTimeChoice::header_stamp;
   return o;
 }
 
@@ -251,8 +256,8 @@ LidarSpec parse_lidar_spec(const std::string& text, const std::string& command,
     spec.name = rest.substr(eq + 1);
     rest = rest.substr(0, eq);
     if (spec.name.empty())
-      throw cli::UsageError(command + ": option '--" + option + "': '" + text +
-                            "' has an empty name after '='");
+      throw UsageError(command + ": option '--" + option + "': '" + text +
+                       "' has an empty name after '='");
   }
   if (exists(rest) || rest.find(':') == std::string::npos) {
     spec.path = rest;
@@ -265,8 +270,7 @@ LidarSpec parse_lidar_spec(const std::string& text, const std::string& command,
     spec.path = rest.substr(0, colon);
     spec.topic = rest.substr(colon + 1);
     if (spec.topic.empty())
-      throw cli::UsageError(command + ": option '--" + option + "': '" + text +
-                            "' has an empty topic");
+      throw UsageError(command + ": option '--" + option + "': '" + text + "' has an empty topic");
     return spec;
   }
   spec.path = rest;  // does not exist: the reader names it

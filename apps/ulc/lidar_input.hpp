@@ -20,8 +20,12 @@
 #include <string>
 #include <vector>
 
-#include "cli_args.hpp"
 #include "ulc/core/point_cloud.hpp"
+
+namespace CLI {
+class App;
+class Option;
+}  // namespace CLI
 
 namespace ulc::app {
 
@@ -96,10 +100,21 @@ std::vector<std::unique_ptr<LidarInput>> open_lidar_inputs(const std::vector<Lid
                                                            const InputOptions& options,
                                                            const std::string& command);
 
+/// --start, --duration and --frame-time as given on the command line.
+struct InputArgs {
+  CLI::Option* start = nullptr;     ///< given when count() > 0; nullptr: not declared
+  CLI::Option* duration = nullptr;  ///< as start
+  double start_s = 0.0;
+  double duration_s = 0.0;
+  std::string frame_time = "header";
+};
+
 /// Declares --start, --duration and --frame-time on a command's options.
-void add_input_options(cli::Args& args);
+void add_input_options(CLI::App& app, InputArgs& args);
+/// Declares --frame-time alone.
+void add_frame_time_option(CLI::App& app, InputArgs& args);
 /// Reads them back (UsageError for a negative start or a duration that is not positive).
-InputOptions input_options(const cli::Args& args, const std::string& command);
+InputOptions input_options(const InputArgs& args, const std::string& command);
 
 /// Prints each input's warnings on stderr as "ulc COMMAND: warning: SOURCE: ...".
 void print_input_warnings(const std::vector<std::unique_ptr<LidarInput>>& inputs,

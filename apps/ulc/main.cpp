@@ -3,12 +3,13 @@
 #include <cstdio>
 #include <cstring>
 #include <exception>
+#include <new>
 #include <string>
 
-#include "cli_args.hpp"
 #include "commands.hpp"
 #include "ulc/io/io_error.hpp"
 #include "ulc/version.hpp"
+#include "usage_error.hpp"
 
 namespace {
 
@@ -54,7 +55,7 @@ int main(int argc, char** argv) {
     if (name != c.name) continue;
     try {
       return c.run(argc - 1, argv + 1);
-    } catch (const ulc::cli::UsageError& e) {
+    } catch (const ulc::app::UsageError& e) {
       std::fprintf(stderr, "ulc %s\n", e.what());
       return ulc::app::kExitUsage;
     } catch (const ulc::io::IoError& e) {

@@ -1,26 +1,28 @@
-// Helpers every benchmark uses: command-line options, median-of-repeats timing, the machine's
-// description, an aligned text table and the same table as a JSON document.
+// Helpers every benchmark uses: the common command-line options (CLI11), median-of-repeats timing,
+// the machine's description, an aligned text table and the same table as a JSON document
+// (nlohmann::json).
 //
 // Conventions: times are wall-clock seconds from std::chrono::steady_clock; a benchmark reports
 // the median over `repeats` runs (the machines are shared and noisy: the median ignores the
 // odd slow run) and compares thread counts measured in the same process run.
 #pragma once
 
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
 #include <string>
 #include <thread>
 #include <utility>
 #include <vector>
-
-#include "ulc/io/json.hpp"
 
 namespace ulc_bench {
 
@@ -29,22 +31,14 @@ struct Options {
   int repeats = 5;    ///< --repeats N (at least 1)
 };
 
-/// Parses --json and --repeats N; prints usage and exits on anything else (bench code only).
-inline Options parse_options(int argc, char** argv, const char* description) {
-  Options options;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg == "--json") {
-      options.json = true;
-    } else if (arg == "--repeats" && i + 1 < argc) {
-      options.repeats = std::max(1, std::atoi(argv[++i]));
-    } else {
-      std::cerr << argv[0] << ": " << description << "\n"
-                << "usage: " << argv[0] << " [--json] [--repeats N]\n";
-      std::exit(arg == "--help" || arg == "-h" ? 0 : 2);
-    }
-  }
-  return options;
+/// Declares --json and --repeats N on a benchmark's command line; each main then declares its
+/// own options and parses with CLI11_PARSE(app, argc, argv) (--help, errors: exit codes of CLI11).
+inline void add_options(CLI::App& app, Options& options) {
+  app.add_flag("--json", options.json, "print a JSON document instead of the table");
+  app.add_option("--repeats", options.repeats,
+                 "runs of each measurement; the median is reported (default 5)")
+      ->type_name("N")
+      ->check(CLI::PositiveNumber);
 }
 
 struct Machine {
@@ -125,15 +119,12 @@ struct Cell {
   }
 };
 
-inline std::string json_string(const std::string& s) {
-  return ulc::io::Json(s).dump(-1);
-}
-
-inline std::string json_value(const Cell& c) {
-  if (!c.number) return json_string(c.text);
-  std::ostringstream out;
-  out << std::setprecision(10) << *c.number;
-  return out.str();
+/// A cell as JSON: its number (a whole one without ".0"), else its text.
+inline nlohmann::ordered_json json_value(const Cell& c) {
+  if (!c.number) return c.text;
+  const double x = *c.number;
+  if (x == std::floor(x) && std::fabs(x) < 1e15) return static_cast<long long>(x);
+  return x;
 }
 
 class Table {
@@ -176,25 +167,26 @@ class Table {
   void write_json(std::ostream& out, const std::string& name, const Machine& m, int repeats,
                   const std::vector<std::pair<std::string, Cell>>& parameters,
                   const std::vector<std::pair<std::string, Cell>>& notes = {}) const {
-    auto object = [&](const std::vector<std::pair<std::string, Cell>>& fields) {
-      std::string s = "{";
-      for (std::size_t i = 0; i < fields.size(); ++i)
-        s += (i ? ", " : "") + json_string(fields[i].first) + ": " + json_value(fields[i].second);
-      return s + "}";
+    using Json = nlohmann::ordered_json;
+    auto object = [](const std::vector<std::pair<std::string, Cell>>& fields) {
+      Json o = Json::object();
+      for (const auto& [key, cell] : fields) o[key] = json_value(cell);
+      return o;
     };
-    out << "{\n  \"benchmark\": " << json_string(name) << ",\n"
-        << "  \"machine\": {\"nproc\": " << m.threads << ", \"cpu\": " << json_string(m.cpu)
-        << ", \"load_average\": " << json_string(m.load) << "},\n"
-        << "  \"repeats\": " << repeats << ",\n"
-        << "  \"parameters\": " << object(parameters) << ",\n"
-        << "  \"rows\": [";
-    for (std::size_t r = 0; r < rows_.size(); ++r) {
+    Json doc = Json::object();
+    doc["benchmark"] = name;
+    doc["machine"] = {{"nproc", m.threads}, {"cpu", m.cpu}, {"load_average", m.load}};
+    doc["repeats"] = repeats;
+    doc["parameters"] = object(parameters);
+    Json rows = Json::array();
+    for (const auto& row : rows_) {
       std::vector<std::pair<std::string, Cell>> fields;
-      for (std::size_t c = 0; c < columns_.size(); ++c)
-        fields.emplace_back(columns_[c], rows_[r][c]);
-      out << (r ? ",\n    " : "\n    ") << object(fields);
+      for (std::size_t c = 0; c < columns_.size(); ++c) fields.emplace_back(columns_[c], row[c]);
+      rows.push_back(object(fields));
     }
-    out << "\n  ],\n  \"notes\": " << object(notes) << "\n}\n";
+    doc["rows"] = std::move(rows);
+    doc["notes"] = object(notes);
+    out << doc.dump(2, ' ', false, Json::error_handler_t::replace) << "\n";
   }
 
  private:
@@ -219,16 +211,6 @@ inline void emit(std::ostream& out, const Table& table, bool json, const std::st
     table.print(out);
     print_notes(out, notes);
   }
-}
-
-/// "a,b,,c" -> {"a", "b", "c"}: the comma-separated lists of the benchmarks' options.
-inline std::vector<std::string> split_list(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream in(s);
-  std::string item;
-  while (std::getline(in, item, ','))
-    if (!item.empty()) out.push_back(item);
-  return out;
 }
 
 }  // namespace ulc_bench

@@ -59,10 +59,10 @@ TEST_CASE("ulc evaluate measures a result against the ground truth", "[app][eval
   REQUIRE(run.exit_code == 0);
   const auto doc = ulc::io::parse_json(run.output);
   const auto& e = doc.at("pairs")[0];
-  CHECK(e.at("e_rot_deg").as_number() == Approx(0.5).epsilon(1e-6));
-  CHECK(e.at("e_trans_m").as_number() == Approx(0.03).epsilon(1e-9));
-  CHECK(e.at("time_offset_error_s").as_number() == Approx(-0.003).epsilon(1e-9));
-  CHECK(e.at("success").as_bool());
+  CHECK(e.at("e_rot_deg").get<double>() == Approx(0.5).epsilon(1e-6));
+  CHECK(e.at("e_trans_m").get<double>() == Approx(0.03).epsilon(1e-9));
+  CHECK(e.at("time_offset_error_s").get<double>() == Approx(-0.003).epsilon(1e-9));
+  CHECK(e.at("success").get<bool>());
 
   // 2 degrees off fails the criterion: exit code 1, and the table says "no".
   r.T_base_target = make_pose(0, 0, 2.0 * M_PI / 180, {0, 0, 0}) * truth;
@@ -93,8 +93,8 @@ TEST_CASE("ulc evaluate finds the reversed pair and inverts it", "[app][evaluate
   INFO(run.output);
   REQUIRE(run.exit_code == 0);
   const auto doc = ulc::io::parse_json(run.output);
-  CHECK(doc.at("pairs")[0].at("e_rot_deg").as_number() < 1e-6);
-  CHECK(std::abs(doc.at("pairs")[0].at("time_offset_error_s").as_number()) < 1e-12);
+  CHECK(doc.at("pairs")[0].at("e_rot_deg").get<double>() < 1e-6);
+  CHECK(std::abs(doc.at("pairs")[0].at("time_offset_error_s").get<double>()) < 1e-12);
 }
 
 TEST_CASE("ulc reports bad usage and unreadable input with exit code 2", "[app][usage]") {
@@ -107,17 +107,32 @@ TEST_CASE("ulc reports bad usage and unreadable input with exit code 2", "[app][
   };
   expect_usage_error("", "usage");
   expect_usage_error("frobnicate", "unknown command 'frobnicate'");
-  expect_usage_error("evaluate --result", "needs a value");
-  expect_usage_error("evaluate --bogus 1", "unknown option '--bogus'");
-  expect_usage_error("evaluate --result a.json", "missing required option '--ground-truth");
+  expect_usage_error("evaluate --result", "evaluate: --result: 1 required FILE missing");
+  expect_usage_error("evaluate --result a.json --ground-truth b.json --bogus",
+                     "evaluate: The following argument was not expected: --bogus");
+  expect_usage_error("evaluate --result a.json", "evaluate: --ground-truth is required");
   expect_usage_error(
       "evaluate --result " + quote(dir.file("missing.json")) + " --ground-truth x.json",
       "missing.json: cannot open file");
   { std::ofstream(dir.file("broken.json")) << "{\"results\": ["; }
   expect_usage_error(
       "evaluate --result " + quote(dir.file("broken.json")) + " --ground-truth x.json",
-      "broken.json: line 1");
+      "broken.json: line 1, column 14: syntax error");
   const auto help = run_command(kUlc + " evaluate --help");
   CHECK(help.exit_code == 0);
   CHECK_THAT(help.output, Catch::Contains("--ground-truth"));
+}
+
+TEST_CASE("ulc --help and ulc <command> --help describe the commands", "[app][usage]") {
+  const auto all = run_command(kUlc + " --help");
+  CHECK(all.exit_code == 0);
+  for (const char* command : {"calibrate", "simulate", "inspect", "export", "evaluate"}) {
+    CHECK_THAT(all.output, Catch::Contains(std::string("  ") + command));
+    for (const char* flag : {" --help", " -h"}) {
+      const auto help = run_command(kUlc + " " + command + flag);
+      INFO(command << flag << "\n" << help.output);
+      CHECK(help.exit_code == 0);
+      CHECK_THAT(help.output, Catch::Contains(std::string("Usage: ulc ") + command));
+    }
+  }
 }

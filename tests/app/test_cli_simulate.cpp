@@ -93,10 +93,10 @@ TEST_CASE("ulc simulate lists scenarios and rejects bad values with exit code 2"
     CHECK_THAT(run.output, Catch::Contains(message));
   };
   usage("--scenario nope --out /tmp/x", "unknown scenario 'nope'");
-  usage("--scenario 64-32", "missing required option '--out");
-  usage("--out /tmp/x", "missing required option '--scenario");
+  usage("--scenario 64-32", "simulate: --out is required");
+  usage("--out /tmp/x", "simulate: --scenario is required");
   usage("--scenario 64-32 --out /tmp/x --seconds -1", "--seconds");
-  usage("--scenario 64-32 --out /tmp/x --seconds abc", "expects a number");
+  usage("--scenario 64-32 --out /tmp/x --seconds abc", "Could not convert: --seconds = abc");
   usage("--scenario 64-32 --out /tmp/x --seed -4", "--seed");
   usage("--scenario 64-32 --out /tmp/x --rate 0", "--rate");
   usage("--scenario 64-32 --out /tmp/x --steering-ramp -2", "--steering-ramp");

@@ -11,8 +11,8 @@
 
 #include "calibrate_test_util.hpp"
 #include "pipeline/calibrate.hpp"
-#include "pipeline/result_entry.hpp"
 #include "ulc/core/pose_error.hpp"
+#include "ulc/io/result_entry.hpp"
 #include "ulc/io/result_file.hpp"
 
 using namespace calibrate_test;
@@ -36,8 +36,8 @@ TEST_CASE("on a 3 s drive HOTS says the clock offset cannot be trusted", "[calib
   CHECK(c.hots->statistics.sequence.time_offset_checked);
   CHECK_FALSE(c.hots->statistics.sequence.time_offset_trusted);
   CHECK(same_bits(c.T_base_target, c.jeep->extrinsic));  // a failed HOTS keeps JEEP's answer
-  const ulc::io::PairResult r = ulc::to_pair_result(c, "lidar64", "lidar32");
-  CHECK(r.stages.at("hots").at("time_offset_trusted").as_bool() == false);
+  const ulc::io::PairResult r = ulc::io::to_pair_result(c, "lidar64", "lidar32");
+  CHECK(r.stages.at("hots").at("time_offset_trusted").get<bool>() == false);
 }
 
 TEST_CASE("terra,jeep,hots recovers the 64-32 mounting with synchronised clocks",
@@ -87,23 +87,24 @@ TEST_CASE("terra,jeep,hots recovers the 64-32 mounting with synchronised clocks"
   CHECK(stages_seen == std::vector<std::string>{"terra", "jeep", "odometry", "hots"});
 
   // The result entry, through the file format and back.
-  const ulc::io::PairResult r = ulc::to_pair_result(c, "lidar64", "lidar32");
+  const ulc::io::PairResult r = ulc::io::to_pair_result(c, "lidar64", "lidar32");
   const auto json = ulc::io::results_to_json({r});
-  const auto back = ulc::io::results_from_json(ulc::io::parse_json(json.dump()), "<test>");
+  const auto back =
+      ulc::io::results_from_json(ulc::io::parse_json(ulc::io::dump_json(json)), "<test>");
   REQUIRE(back.size() == 1);
   REQUIRE(back[0].time_offset_s);
   CHECK(*back[0].time_offset_s == Approx(c.time_offset_s).margin(1e-12));
   REQUIRE(back[0].covariance_6x6);
   CHECK(back[0].covariance_6x6->isApprox(*c.covariance_6x6, 1e-12));
-  CHECK(back[0].timing_s.at("odometry").as_number() == c.timing_s.odometry);
-  CHECK(back[0].timing_s.at("hots").as_number() == c.timing_s.hots);
+  CHECK(back[0].timing_s.at("odometry").get<double>() == c.timing_s.odometry);
+  CHECK(back[0].timing_s.at("hots").get<double>() == c.timing_s.hots);
   const auto& hj = back[0].stages.at("hots");
-  CHECK(hj.at("status").as_string() == "ok");
-  CHECK(hj.at("windows").as_number() == static_cast<double>(h.statistics.windows));
-  CHECK(hj.at("planes").as_number() == static_cast<double>(h.statistics.planes));
-  CHECK(hj.at("graph_iterations").as_number() == h.statistics.graph_iterations);
-  CHECK(hj.at("graph_cost").as_number() == Approx(h.statistics.graph_cost));
-  CHECK(hj.at("time_sync_spread").as_number() == Approx(h.statistics.time_sync_spread));
+  CHECK(hj.at("status").get<std::string>() == "ok");
+  CHECK(hj.at("windows").get<double>() == static_cast<double>(h.statistics.windows));
+  CHECK(hj.at("planes").get<double>() == static_cast<double>(h.statistics.planes));
+  CHECK(hj.at("graph_iterations").get<double>() == h.statistics.graph_iterations);
+  CHECK(hj.at("graph_cost").get<double>() == Approx(h.statistics.graph_cost));
+  CHECK(hj.at("time_sync_spread").get<double>() == Approx(h.statistics.time_sync_spread));
   CHECK(hj.at("spread_curve").size() == h.spread_curve.size());
 }
 
@@ -166,10 +167,10 @@ TEST_CASE("a failing odometry or HOTS gives hots_failed and keeps the extrinsic 
   CHECK(hots_failed.hots->status == hots::RefineStatus::invalid_input);
   CHECK(same_bits(hots_failed.T_base_target, *o.initial));
   CHECK(hots_failed.time_offset_s == 0.0);
-  const auto entry = ulc::to_pair_result(hots_failed, "lidar64", "lidar32");
+  const auto entry = ulc::io::to_pair_result(hots_failed, "lidar64", "lidar32");
   CHECK(entry.status == "hots_failed");
   CHECK(!entry.covariance_6x6);
-  CHECK(entry.stages.at("hots").at("status").as_string() == "invalid_input");
+  CHECK(entry.stages.at("hots").at("status").get<std::string>() == "invalid_input");
 
   // Without terra, hots alone needs a guess.
   o.initial.reset();

@@ -9,8 +9,8 @@
 
 #include "calibrate_test_util.hpp"
 #include "pipeline/calibrate.hpp"
-#include "pipeline/result_entry.hpp"
 #include "ulc/core/pose_error.hpp"
+#include "ulc/io/result_entry.hpp"
 
 using namespace calibrate_test;
 using ulc::CalibrateStatus;
@@ -60,11 +60,11 @@ TEST_CASE("when HOTS refuses every start, TERRA's next hypotheses are tried and 
   CHECK(c.jeep->initial.linear().isApprox(tried[0].rotation));
   CHECK(std::find(stages_seen.begin(), stages_seen.end(), "jeep (hypothesis 2)") !=
         stages_seen.end());
-  const auto entry = ulc::to_pair_result(c, "lidar64", "lidar32");
+  const auto entry = ulc::io::to_pair_result(c, "lidar64", "lidar32");
   CHECK(entry.stages.at("terra").at("hypotheses").size() == tried.size());
-  CHECK(entry.stages.at("terra").at("hypotheses")[std::size_t{0}].at("source").as_string() ==
+  CHECK(entry.stages.at("terra").at("hypotheses")[std::size_t{0}].at("source").get<std::string>() ==
         ulc::to_string(c.terra->source));
-  CHECK(entry.stages.at("terra").at("hypothesis_used").as_number() == 0.0);
+  CHECK(entry.stages.at("terra").at("hypothesis_used").get<double>() == 0.0);
 
   // One hypothesis and no fallback: the paper's single answer, and nothing else is tried.
   o.tuning.hypotheses.count = 1;
@@ -101,10 +101,10 @@ TEST_CASE("a JEEP that did not settle is judged by HOTS, which confirms and refi
                << " deg " << ej.translation_m << " m");
   CHECK(e.rotation_deg < 0.1);
   CHECK(e.translation_m < 0.02);
-  CHECK(ulc::to_pair_result(c, "lidar64", "lidar32")
+  CHECK(ulc::io::to_pair_result(c, "lidar64", "lidar32")
             .stages.at("jeep")
             .at("judged_by_hots")
-            .as_bool());
+            .get<bool>());
 
   // JEEP's verdict stands when asked to: the call ends with JEEP's failure and its input.
   o.tuning.hypotheses.hots_judges_jeep = false;

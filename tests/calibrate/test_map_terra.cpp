@@ -10,8 +10,8 @@
 #include "calibrate_test_util.hpp"
 #include "pipeline/calibrate.hpp"
 #include "pipeline/map_terra.hpp"
-#include "pipeline/result_entry.hpp"
 #include "ulc/core/pose_error.hpp"
+#include "ulc/io/result_entry.hpp"
 #include "ulc/sim/sim.hpp"
 
 namespace {
@@ -108,13 +108,13 @@ TEST_CASE("TERRA on 3 s local maps finds the 64-tele rotation that single frames
   CHECK(*automatic.terra->frames_mask_count == *frames.terra->frames_mask_count);
 
   // The result entry says which source, with the maps' statistics.
-  const ulc::io::PairResult r = ulc::to_pair_result(automatic, "lidar64", "tele");
+  const ulc::io::PairResult r = ulc::io::to_pair_result(automatic, "lidar64", "tele");
   const auto& t = r.stages.at("terra");
-  CHECK(t.at("source").as_string() == "maps");
-  CHECK(t.at("frames_mask_count").as_number() ==
+  CHECK(t.at("source").get<std::string>() == "maps");
+  CHECK(t.at("frames_mask_count").get<double>() ==
         static_cast<double>(*automatic.terra->frames_mask_count));
-  CHECK(t.at("base_map").at("frames").as_number() == 31.0);
-  CHECK(t.at("target_map").at("points").as_number() ==
+  CHECK(t.at("base_map").at("frames").get<double>() == 31.0);
+  CHECK(t.at("target_map").at("points").get<double>() ==
         static_cast<double>(automatic.terra->target_map->points));
 }
 

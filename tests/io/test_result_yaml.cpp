@@ -1,9 +1,14 @@
-// The YAML result: every form of the extrinsic it prints must rebuild the same transform.
-#include <catch2/catch.hpp>
+// The YAML result: it parses back with yaml-cpp, and every form of the extrinsic it prints must
+// rebuild the same transform.
+#include <yaml-cpp/yaml.h>
 
 #include <Eigen/Geometry>
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <limits>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "ulc/core/lie.hpp"
 #include "ulc/core/pose_error.hpp"
@@ -11,17 +16,10 @@
 
 namespace {
 
-/// The text after `key: ` on the first line holding it (inside the first result).
-std::string value_of(const std::string& yaml, const std::string& key) {
-  const auto at = yaml.find(key + ": ");
-  REQUIRE(at != std::string::npos);
-  const auto begin = at + key.size() + 2;
-  return yaml.substr(begin, yaml.find('\n', begin) - begin);
-}
-
+/// The numbers of a text such as "0.31 -1.2 0.05" or "--x 0.31 --y -1.2" (words skipped).
 std::vector<double> numbers(std::string s) {
   for (char& c : s)
-    if (c == '[' || c == ']' || c == ',' || c == '"') c = ' ';
+    if (c == '"') c = ' ';
   std::istringstream in(s);
   std::vector<double> out;
   std::string word;
@@ -34,6 +32,10 @@ std::vector<double> numbers(std::string s) {
     }
   }
   return out;
+}
+
+std::vector<double> list(const YAML::Node& node) {
+  return node.as<std::vector<double>>();
 }
 
 Eigen::Isometry3d from_xyz_rpy(double x, double y, double z, double roll, double pitch,
@@ -50,7 +52,7 @@ ulc::io::PairResult example() {
   r.target = "left";
   r.success = true;
   r.status = "ok";
-  r.reason = "a \"quoted\" word";
+  r.reason = "a \"quoted\" word: with a colon";
   r.time_offset_s = 0.0125;
   r.T_base_target = from_xyz_rpy(0.31, -1.2, 0.05, 0.4, -1.1, 2.9);
   return r;
@@ -60,53 +62,65 @@ ulc::io::PairResult example() {
 
 TEST_CASE("YAML result: matrix, quaternions, rpy, ROS and URDF forms all give the transform") {
   const ulc::io::PairResult r = example();
-  const std::string yaml = ulc::io::results_to_yaml({r});
+  const std::string text = ulc::io::results_to_yaml({r});
+  const YAML::Node yaml = YAML::Load(text);
+  REQUIRE(yaml["results"].size() == 1);
+  const YAML::Node e = yaml["results"][0];
   const Eigen::Matrix4d M = r.T_base_target.matrix();
 
-  // The matrix rows follow "T_base_target:" as four "- [...]" lines.
-  std::istringstream lines(yaml.substr(yaml.find("T_base_target:")));
-  std::string line;
-  std::getline(lines, line);
+  REQUIRE(e["T_base_target"].size() == 4);
   for (int i = 0; i < 4; ++i) {
-    std::getline(lines, line);
-    const auto row = numbers(line);
+    const auto row = list(e["T_base_target"][i]);
     REQUIRE(row.size() == 4);
     for (int j = 0; j < 4; ++j) CHECK(row[j] == Approx(M(i, j)).margin(1e-8));
   }
+  // The matrix rows read as rows in the text too.
+  CHECK(text.find("    T_base_target:\n      - [") != std::string::npos);
 
-  const auto wxyz = numbers(value_of(yaml, "rotation_quat_wxyz"));
-  const auto xyzw = numbers(value_of(yaml, "rotation_quat_xyzw"));
+  const auto wxyz = list(e["rotation_quat_wxyz"]);
+  const auto xyzw = list(e["rotation_quat_xyzw"]);
   REQUIRE(wxyz.size() == 4);
   REQUIRE(xyzw.size() == 4);
   const Eigen::Quaterniond q(wxyz[0], wxyz[1], wxyz[2], wxyz[3]);
   CHECK(ulc::rotation_error_rad(q.toRotationMatrix(), r.T_base_target.linear()) < 1e-7);
   CHECK(xyzw[3] == wxyz[0]);
   CHECK(xyzw[0] == wxyz[1]);
+  const auto rpy = list(e["rpy_rad"]);
+  const auto rpy_deg = list(e["rpy_deg"]);
+  const auto t = list(e["translation_m"]);
+  REQUIRE(rpy.size() == 3);
+  REQUIRE(t.size() == 3);
+  CHECK(from_xyz_rpy(t[0], t[1], t[2], rpy[0], rpy[1], rpy[2]).isApprox(r.T_base_target, 1e-7));
+  CHECK(rpy_deg.at(2) == Approx(rpy[2] * 180.0 / 3.14159265358979323846));
 
   // ROS 1: x y z yaw pitch roll parent child.
-  const std::string ros1 = value_of(yaml, "static_transform_publisher");
+  const std::string ros1 = e["static_transform_publisher"].as<std::string>();
   const auto s = numbers(ros1);
   REQUIRE(s.size() == 6);
   CHECK(from_xyz_rpy(s[0], s[1], s[2], s[5], s[4], s[3]).isApprox(r.T_base_target, 1e-7));
-  CHECK(ros1.find(" top left\"") != std::string::npos);
+  CHECK(ros1.size() > 9);
+  CHECK(ros1.substr(ros1.size() - 9) == " top left");
 
   // ROS 2: named arguments.
-  const auto s2 = numbers(value_of(yaml, "ros2_static_transform_publisher"));
+  const auto s2 = numbers(e["ros2_static_transform_publisher"].as<std::string>());
   REQUIRE(s2.size() == 6);
   CHECK(from_xyz_rpy(s2[0], s2[1], s2[2], s2[3], s2[4], s2[5]).isApprox(r.T_base_target, 1e-7));
 
   // URDF: <origin xyz="..." rpy="..."/> with parent = base, child = target.
-  const auto origin = yaml.find("<origin xyz=\"");
+  const std::string urdf = e["urdf_joint"].as<std::string>();
+  const auto origin = urdf.find("<origin xyz=\"");
   REQUIRE(origin != std::string::npos);
-  const auto u = numbers(yaml.substr(origin, yaml.find("/>", origin) - origin));
+  const auto u = numbers(urdf.substr(origin + 13, urdf.find("/>", origin) - origin - 13));
   REQUIRE(u.size() == 6);
   CHECK(from_xyz_rpy(u[0], u[1], u[2], u[3], u[4], u[5]).isApprox(r.T_base_target, 1e-7));
-  CHECK(yaml.find("<parent link=\"top\"/>") != std::string::npos);
-  CHECK(yaml.find("<child link=\"left\"/>") != std::string::npos);
+  CHECK(urdf.find("<parent link=\"top\"/>") != std::string::npos);
+  CHECK(urdf.find("<child link=\"left\"/>") != std::string::npos);
 
-  CHECK(value_of(yaml, "reason") == "\"a \\\"quoted\\\" word\"");
-  CHECK(numbers(value_of(yaml, "time_offset_s")).at(0) == Approx(0.0125));
-  CHECK(value_of(yaml, "success") == "true");
+  CHECK(e["reason"].as<std::string>() == r.reason);
+  CHECK(e["time_offset_s"].as<double>() == 0.0125);
+  CHECK(e["success"].as<bool>());
+  CHECK(e["base"].as<std::string>() == "top");
+  CHECK(e["status"].as<std::string>() == "ok");
 }
 
 TEST_CASE("YAML result: one entry per target, a missing time offset is null") {
@@ -114,14 +128,25 @@ TEST_CASE("YAML result: one entry per target, a missing time offset is null") {
   b.target = "right";
   b.time_offset_s.reset();
   b.success = false;
-  const std::string yaml = ulc::io::results_to_yaml({a, b});
-  std::size_t entries = 0;
-  for (std::size_t at = yaml.find("  - base: "); at != std::string::npos;
-       at = yaml.find("  - base: ", at + 1))
-    ++entries;
-  CHECK(entries == 2);
-  CHECK(yaml.find("time_offset_s: null") != std::string::npos);
-  CHECK(yaml.find("success: false") != std::string::npos);
+  const YAML::Node yaml = YAML::Load(ulc::io::results_to_yaml({a, b}));
+  REQUIRE(yaml["results"].size() == 2);
+  CHECK(yaml["results"][1]["target"].as<std::string>() == "right");
+  CHECK(yaml["results"][1]["time_offset_s"].IsNull());
+  CHECK_FALSE(yaml["results"][1]["success"].as<bool>());
+  CHECK_FALSE(yaml["results"][0]["via"].IsDefined());
+}
+
+TEST_CASE("YAML result: non-finite numbers are YAML's .nan and .inf") {
+  ulc::io::PairResult r = example();
+  r.time_offset_s = std::numeric_limits<double>::quiet_NaN();
+  r.T_base_target.translation().x() = std::numeric_limits<double>::infinity();
+  const std::string text = ulc::io::results_to_yaml({r});
+  CHECK(text.find("nan,") == std::string::npos);  // no bare nan: not YAML
+  CHECK(text.find("time_offset_s: .nan") != std::string::npos);
+  const YAML::Node e = YAML::Load(text)["results"][0];
+  CHECK(std::isnan(e["time_offset_s"].as<double>()));
+  CHECK(list(e["translation_m"]).at(0) == std::numeric_limits<double>::infinity());
+  CHECK(list(e["T_base_target"][0]).at(3) == std::numeric_limits<double>::infinity());
 }
 
 TEST_CASE("YAML result: a routed entry names its route, a rig's cycles follow the results") {
@@ -137,26 +162,29 @@ TEST_CASE("YAML result: a routed entry names its route, a rig's cycles follow th
   closed.translation_m = 0.0075;
   open.lidars = {"top", "left", "back"};
   open.status = "terra_failed";
-  const std::string yaml = ulc::io::results_to_yaml({a, b}, {closed, open});
-  // The route only on the routed entry, after the results.
-  CHECK(yaml.find("via: ") == yaml.find("    via: \"left\"\n") + 4);
-  CHECK(yaml.find("via: ") > yaml.find("target: \"right\""));
-  CHECK(yaml.find("direct_status: \"jeep_failed\"") != std::string::npos);
-  CHECK(yaml.find("direct_reason: \"JEEP: rejected\"") != std::string::npos);
-  const auto cycles = yaml.find("\ncycles:\n");
-  REQUIRE(cycles != std::string::npos);
-  CHECK(cycles > yaml.find("</joint>", yaml.find("target: \"right\"")));
-  const std::string tail = yaml.substr(cycles);
-  CHECK(tail.find("  - lidars: [\"top\", \"left\", \"right\"]\n    status: \"ok\"") !=
-        std::string::npos);
-  CHECK(numbers(value_of(tail, "rotation_deg")).at(0) == 0.125);
-  CHECK(numbers(value_of(tail, "translation_m")).at(0) == 0.0075);
-  CHECK(tail.find("rotation_deg: null") > tail.find("\"back\""));
-  // Without cycles there is no cycles key (files of single pairs stay as they were).
-  CHECK(ulc::io::results_to_yaml({a}).find("cycles") == std::string::npos);
+  const std::string text = ulc::io::results_to_yaml({a, b}, {closed, open});
+  const YAML::Node yaml = YAML::Load(text);
+  // The route only on the routed entry.
+  CHECK_FALSE(yaml["results"][0]["via"].IsDefined());
+  CHECK(yaml["results"][1]["via"].as<std::string>() == "left");
+  CHECK(yaml["results"][1]["direct_status"].as<std::string>() == "jeep_failed");
+  CHECK(yaml["results"][1]["direct_reason"].as<std::string>() == "JEEP: rejected");
+  const YAML::Node cycles = yaml["cycles"];
+  REQUIRE(cycles.size() == 2);
+  CHECK(cycles[0]["lidars"].as<std::vector<std::string>>() ==
+        std::vector<std::string>{"top", "left", "right"});
+  CHECK(cycles[0]["status"].as<std::string>() == "ok");
+  CHECK(cycles[0]["rotation_deg"].as<double>() == 0.125);
+  CHECK(cycles[0]["translation_m"].as<double>() == 0.0075);
+  CHECK(cycles[1]["rotation_deg"].IsNull());
+  CHECK(cycles[1]["lidars"][2].as<std::string>() == "back");
+  // The cycles come after the results, with their comment; without cycles there is no key.
+  CHECK(text.find("# cycle closure") < text.find("\ncycles:\n"));
+  CHECK(text.find("\ncycles:\n") > text.find("target: \"right\""));
+  CHECK_FALSE(YAML::Load(ulc::io::results_to_yaml({a}))["cycles"].IsDefined());
 }
 
 TEST_CASE("YAML result: an unwritable path throws an IoError naming it") {
-  CHECK_THROWS_AS(ulc::io::write_result_yaml("/nonexistent_dir/x.yaml", {example()}),
-                  ulc::io::IoError);
+  CHECK_THROWS_WITH(ulc::io::write_result_yaml("/nonexistent_dir/x.yaml", {example()}),
+                    Catch::Contains("/nonexistent_dir/x.yaml"));
 }

@@ -18,4 +18,5 @@ run(${CMAKE_COMMAND} -S ${ULC_SOURCE_DIR}/tests/package_consumer -B ${WORK_DIR}/
 run(${CMAKE_COMMAND} --build ${WORK_DIR}/consumer-build)
 run(${WORK_DIR}/consumer-build/consumer)
 run(${WORK_DIR}/consumer-build/consumer_bags)
+run(${WORK_DIR}/consumer-build/consumer_results)
 run(${WORK_DIR}/consumer-build/consumer_calibrate)

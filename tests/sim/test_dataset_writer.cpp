@@ -142,10 +142,10 @@ TEST_CASE("dataset folder: layout, PCD bytes, timestamps, trajectory, ground tru
   CHECK(gt.pairs[0].T_base_target.isApprox(memory.dataset.pairs[0].T_base_target, 1e-14));
   // The file itself holds every double exactly (the reader re-orthonormalises, so check raw).
   const ulc::io::Json doc = ulc::io::read_json_file((tmp.path / "ground_truth.json").string());
-  const ulc::io::Json& m = (*(*doc.find("pairs"))[0].find("T_base_target"));
+  const ulc::io::Json& m = doc.at("pairs")[0].at("T_base_target");
   for (int r = 0; r < 4; ++r)
     for (int c = 0; c < 4; ++c)
-      CHECK(m[static_cast<std::size_t>(r)][static_cast<std::size_t>(c)].as_number() ==
+      CHECK(m[static_cast<std::size_t>(r)][static_cast<std::size_t>(c)].get<double>() ==
             memory.dataset.pairs[0].T_base_target.matrix()(r, c));
   REQUIRE(gt.pairs[0].time_offset_s);
   CHECK(*gt.pairs[0].time_offset_s == 0.02);

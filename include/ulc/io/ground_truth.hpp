@@ -7,8 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "ulc/io/json.hpp"
-#include "ulc/io/json_eigen.hpp"
+#include "ulc/io/json_file.hpp"
 
 namespace ulc::io {
 
@@ -71,35 +70,36 @@ inline Json to_json(const GroundTruth& gt) {
 inline GroundTruth ground_truth_from_json(const Json& doc, const std::string& file) {
   if (!doc.is_object()) throw IoError(file, "", "expected a JSON object");
   GroundTruth gt;
-  if (const Json* lidars = doc.find("lidars")) {
+  if (const Json* lidars = find_member(doc, "lidars")) {
     if (!lidars->is_object()) throw IoError(file, "lidars", "expected an object");
-    for (const auto& kv : lidars->as_object()) {
+    for (auto kv = lidars->begin(); kv != lidars->end(); ++kv) {
       LidarTruth l;
-      l.name = kv.first;
-      const std::string where = "lidars." + kv.first;
-      if (const Json* m = kv.second.find("model"); m && m->is_string()) l.model = m->as_string();
-      const Json* t = kv.second.find("T_vehicle_lidar");
+      l.name = kv.key();
+      const std::string where = "lidars." + kv.key();
+      if (const Json* m = find_member(kv.value(), "model"); m && m->is_string())
+        l.model = m->get<std::string>();
+      const Json* t = find_member(kv.value(), "T_vehicle_lidar");
       if (!t) throw IoError(file, where, "missing T_vehicle_lidar");
       l.T_vehicle_lidar = json_to_isometry(*t, file, where + ".T_vehicle_lidar");
       gt.lidars.push_back(std::move(l));
     }
   }
-  const Json* pairs = doc.find("pairs");
+  const Json* pairs = find_member(doc, "pairs");
   if (!pairs || !pairs->is_array()) throw IoError(file, "pairs", "missing array \"pairs\"");
   for (std::size_t i = 0; i < pairs->size(); ++i) {
     const Json& e = (*pairs)[i];
     const std::string where = "pairs[" + std::to_string(i) + "]";
-    const Json* base = e.find("base");
-    const Json* target = e.find("target");
-    const Json* t = e.find("T_base_target");
+    const Json* base = find_member(e, "base");
+    const Json* target = find_member(e, "target");
+    const Json* t = find_member(e, "T_base_target");
     if (!base || !base->is_string() || !target || !target->is_string() || !t)
       throw IoError(file, where, "needs string \"base\", string \"target\" and \"T_base_target\"");
     PairTruth p;
-    p.base = base->as_string();
-    p.target = target->as_string();
+    p.base = base->get<std::string>();
+    p.target = target->get<std::string>();
     p.T_base_target = json_to_isometry(*t, file, where + ".T_base_target");
-    if (const Json* dt = e.find("time_offset_s"); dt && dt->is_number())
-      p.time_offset_s = dt->as_number();
+    if (const Json* dt = find_member(e, "time_offset_s"); dt && dt->is_number())
+      p.time_offset_s = json_to_number(*dt, file, where + ".time_offset_s");
     gt.pairs.push_back(std::move(p));
   }
   return gt;

@@ -21,8 +21,7 @@
 #include <vector>
 
 #include "ulc/core/lie.hpp"
-#include "ulc/io/json.hpp"
-#include "ulc/io/json_eigen.hpp"
+#include "ulc/io/json_file.hpp"
 
 namespace ulc::io {
 
@@ -113,7 +112,7 @@ inline Json results_to_json(const std::vector<PairResult>& results,
 
 /// Reads the fields a consumer needs (the matrix is authoritative over the other spellings).
 inline std::vector<PairResult> results_from_json(const Json& doc, const std::string& file) {
-  const Json* list = doc.find("results");
+  const Json* list = find_member(doc, "results");
   if (!list || !list->is_array())
     throw IoError(file, "results", "missing array \"results\" (is this a ulc result file?)");
   std::vector<PairResult> out;
@@ -122,28 +121,32 @@ inline std::vector<PairResult> results_from_json(const Json& doc, const std::str
     const std::string where = "results[" + std::to_string(i) + "]";
     if (!e.is_object()) throw IoError(file, where, "expected an object");
     PairResult r;
-    const Json* base = e.find("base");
-    const Json* target = e.find("target");
+    const Json* base = find_member(e, "base");
+    const Json* target = find_member(e, "target");
     if (!base || !base->is_string() || !target || !target->is_string())
       throw IoError(file, where, "needs string \"base\" and \"target\"");
-    r.base = base->as_string();
-    r.target = target->as_string();
-    if (const Json* s = e.find("success"); s && s->is_bool()) r.success = s->as_bool();
-    if (const Json* s = e.find("status"); s && s->is_string()) r.status = s->as_string();
-    if (const Json* s = e.find("reason"); s && s->is_string()) r.reason = s->as_string();
-    const Json* t = e.find("T_base_target");
+    r.base = base->get<std::string>();
+    r.target = target->get<std::string>();
+    if (const Json* s = find_member(e, "success"); s && s->is_boolean()) r.success = s->get<bool>();
+    if (const Json* s = find_member(e, "status"); s && s->is_string())
+      r.status = s->get<std::string>();
+    if (const Json* s = find_member(e, "reason"); s && s->is_string())
+      r.reason = s->get<std::string>();
+    const Json* t = find_member(e, "T_base_target");
     if (!t) throw IoError(file, where, "missing T_base_target");
     r.T_base_target = json_to_isometry(*t, file, where + ".T_base_target");
-    if (const Json* dt = e.find("time_offset_s"); dt && dt->is_number())
-      r.time_offset_s = dt->as_number();
-    if (const Json* c = e.find("covariance_6x6"); c && c->is_array())
+    if (const Json* dt = find_member(e, "time_offset_s"); dt && dt->is_number())
+      r.time_offset_s = json_to_number(*dt, file, where + ".time_offset_s");
+    if (const Json* c = find_member(e, "covariance_6x6"); c && c->is_array())
       r.covariance_6x6 = json_to_matrix<6, 6>(*c, file, where + ".covariance_6x6");
-    if (const Json* s = e.find("stages"); s && s->is_object()) r.stages = *s;
-    if (const Json* s = e.find("timing_s"); s && s->is_object()) r.timing_s = *s;
-    if (const Json* v = e.find("via"); v && v->is_string()) r.via = v->as_string();
-    if (const Json* d = e.find("direct"); d && d->is_object()) {
-      if (const Json* s = d->find("status"); s && s->is_string()) r.direct_status = s->as_string();
-      if (const Json* s = d->find("reason"); s && s->is_string()) r.direct_reason = s->as_string();
+    if (const Json* s = find_member(e, "stages"); s && s->is_object()) r.stages = *s;
+    if (const Json* s = find_member(e, "timing_s"); s && s->is_object()) r.timing_s = *s;
+    if (const Json* v = find_member(e, "via"); v && v->is_string()) r.via = v->get<std::string>();
+    if (const Json* d = find_member(e, "direct"); d && d->is_object()) {
+      if (const Json* s = find_member(*d, "status"); s && s->is_string())
+        r.direct_status = s->get<std::string>();
+      if (const Json* s = find_member(*d, "reason"); s && s->is_string())
+        r.direct_reason = s->get<std::string>();
     }
     out.push_back(std::move(r));
   }
@@ -153,26 +156,28 @@ inline std::vector<PairResult> results_from_json(const Json& doc, const std::str
 /// The top-level "cycles" (empty when the file has none).
 inline std::vector<CycleResult> cycles_from_json(const Json& doc, const std::string& file) {
   std::vector<CycleResult> out;
-  const Json* list = doc.find("cycles");
+  const Json* list = find_member(doc, "cycles");
   if (!list) return out;
   if (!list->is_array()) throw IoError(file, "cycles", "expected an array");
   for (std::size_t i = 0; i < list->size(); ++i) {
     const Json& e = (*list)[i];
     const std::string where = "cycles[" + std::to_string(i) + "]";
-    const Json* lidars = e.is_object() ? e.find("lidars") : nullptr;
+    const Json* lidars = find_member(e, "lidars");
     if (!lidars || !lidars->is_array())
       throw IoError(file, where, "needs an array \"lidars\" of names");
     CycleResult c;
     for (std::size_t k = 0; k < lidars->size(); ++k) {
       if (!(*lidars)[k].is_string()) throw IoError(file, where + ".lidars", "expected names");
-      c.lidars.push_back((*lidars)[k].as_string());
+      c.lidars.push_back((*lidars)[k].get<std::string>());
     }
-    if (const Json* s = e.find("status"); s && s->is_string()) c.status = s->as_string();
-    if (const Json* s = e.find("reason"); s && s->is_string()) c.reason = s->as_string();
-    if (const Json* x = e.find("rotation_deg"); x && x->is_number())
-      c.rotation_deg = x->as_number();
-    if (const Json* x = e.find("translation_m"); x && x->is_number())
-      c.translation_m = x->as_number();
+    if (const Json* s = find_member(e, "status"); s && s->is_string())
+      c.status = s->get<std::string>();
+    if (const Json* s = find_member(e, "reason"); s && s->is_string())
+      c.reason = s->get<std::string>();
+    if (const Json* x = find_member(e, "rotation_deg"); x && x->is_number())
+      c.rotation_deg = json_to_number(*x, file, where + ".rotation_deg");
+    if (const Json* x = find_member(e, "translation_m"); x && x->is_number())
+      c.translation_m = json_to_number(*x, file, where + ".translation_m");
     out.push_back(std::move(c));
   }
   return out;

@@ -11,7 +11,7 @@
 //                               (the clock of LiDARs with zero clock offset), "%.9f" for t and
 //                               x y z, "%.12f" for the unit quaternion
 //   DIR/ground_truth.json       lidars (model, T_vehicle_lidar), pairs (T_base_target,
-//                               time_offset_s) and the offset convention, 17 significant digits
+//                               time_offset_s) and the offset convention, every double exactly
 // Frame files that a previous, longer run left in a LiDAR folder (six-digit names beyond this
 // run's frame count) are removed, so each LiDAR folder describes one run. Nothing else in DIR
 // is touched: folders of LiDARs that this run does not have stay, so write each scenario into

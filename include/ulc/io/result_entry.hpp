@@ -4,37 +4,36 @@
 //   - time_offset_s is the caller's known offset or HOTS's when it succeeded, otherwise 0
 //     (clocks assumed synchronised); covariance_6x6 is HOTS's, null without it.
 //   - "stages" holds one object per stage that ran ("terra", "jeep", "hots"); "timing_s" always
-//   holds
-//     every stage key of docs/design.md ("terra", "jeep", "odometry", "hots", "total"), 0 for a
-//     stage that did not run.
+//     holds every stage key of docs/design.md ("terra", "jeep", "odometry", "hots", "total"), 0
+//     for a stage that did not run.
 //   - Angles in the stage objects are degrees, distances metres, times seconds.
-// This is an I/O-side header (it builds ulc::io::Json): unlike pipeline/calibrate.hpp it is not
-// part of the -fno-exceptions promise.
+// An I/O-side header of component ulc::results (it builds ulc::Json, nlohmann::ordered_json):
+// the pipeline's headers hold no JSON, and unlike pipeline/calibrate.hpp this is not part of the
+// -fno-exceptions promise.
 #pragma once
 
 #include <string>
 
 #include "pipeline/pair_calibration.hpp"
 #include "ulc/core/lie.hpp"
-#include "ulc/io/json.hpp"
-#include "ulc/io/json_eigen.hpp"
+#include "ulc/io/json_file.hpp"
 #include "ulc/io/result_file.hpp"
 
-namespace ulc {
+namespace ulc::io {
 
 namespace result_detail {
 
 constexpr double kDegPerRad = 180.0 / 3.14159265358979323846;
 
-inline io::Json stage_stats(const terra::StageStats& s) {
-  io::Json j = io::Json::object();
+inline Json stage_stats(const terra::StageStats& s) {
+  Json j = Json::object();
   j["rotations"] = s.rotations;
   j["seconds"] = s.seconds;
   return j;
 }
 
-inline io::Json local_map_stats(const LocalMapStats& m) {
-  io::Json j = io::Json::object();
+inline Json local_map_stats(const LocalMapStats& m) {
+  Json j = Json::object();
   j["frames"] = m.frames;
   j["stacked_points"] = m.stacked_points;
   j["points"] = m.points;
@@ -51,13 +50,13 @@ inline io::Json local_map_stats(const LocalMapStats& m) {
 /// stages.terra: the search's outcome and the statistics a profiler needs; "source" says
 /// whether it compared frames or local maps ("base_map" / "target_map" hold the maps'
 /// statistics when the map search ran, "frames_mask_count" the frame search's overlap).
-inline io::Json terra_to_json(const TerraReport& t) {
+inline Json terra_to_json(const TerraReport& t) {
   using result_detail::stage_stats;
-  io::Json j = io::Json::object();
+  Json j = Json::object();
   j["status"] = terra::to_string(t.status);
   j["reason"] = t.reason;
   j["frame_index"] = t.frame_index;
-  j["rpy_deg"] = io::vector_to_json(rpy_from_rotation(t.rotation) * result_detail::kDegPerRad);
+  j["rpy_deg"] = vector_to_json(rpy_from_rotation(t.rotation) * result_detail::kDegPerRad);
   j["distance"] = t.distance;
   j["mask_count"] = t.mask_count;
   j["base_points"] = t.base_points;
@@ -67,7 +66,7 @@ inline io::Json terra_to_json(const TerraReport& t) {
   j["d1_adapted"] = t.stats.d1_adapted;
   j["base_cells_beyond_d1"] = t.stats.base_beyond_d1;
   j["target_cells_beyond_d1"] = t.stats.target_beyond_d1;
-  io::Json stages = io::Json::object();
+  Json stages = Json::object();
   stages["overlap"] = stage_stats(t.stats.overlap);
   stages["coarse"] = stage_stats(t.stats.coarse);
   stages["fine"] = stage_stats(t.stats.fine);
@@ -83,11 +82,11 @@ inline io::Json terra_to_json(const TerraReport& t) {
   }
   if (t.base_map) j["base_map"] = result_detail::local_map_stats(*t.base_map);
   if (t.target_map) j["target_map"] = result_detail::local_map_stats(*t.target_map);
-  io::Json hypotheses = io::Json::array();
+  Json hypotheses = Json::array();
   for (const TerraHypothesis& h : t.hypotheses) {
-    io::Json e = io::Json::object();
+    Json e = Json::object();
     e["source"] = to_string(h.source);
-    e["rpy_deg"] = io::vector_to_json(rpy_from_rotation(h.rotation) * result_detail::kDegPerRad);
+    e["rpy_deg"] = vector_to_json(rpy_from_rotation(h.rotation) * result_detail::kDegPerRad);
     e["distance"] = h.distance;
     e["mask_count"] = h.mask_count;
     e["outcome"] = h.status == CalibrateStatus::ok
@@ -102,13 +101,13 @@ inline io::Json terra_to_json(const TerraReport& t) {
 }
 
 /// stages.jeep: rounds, status and the last calibration phase's cost and inliers.
-inline io::Json jeep_to_json(const JeepReport& r) {
-  io::Json j = io::Json::object();
+inline Json jeep_to_json(const JeepReport& r) {
+  Json j = Json::object();
   j["status"] = jeep::to_string(r.status);
   j["reason"] = r.reason;
   j["rounds"] = r.rounds;
   j["frame_pairs"] = r.frame_pairs;
-  j["initial_T_base_target"] = io::matrix_to_json(r.initial.matrix());
+  j["initial_T_base_target"] = matrix_to_json(r.initial.matrix());
   j["calibration_status"] = to_string(r.calibration_status);
   j["final_cost"] = r.final_cost;
   j["final_inliers"] = r.final_inliers;
@@ -141,9 +140,9 @@ inline std::string hots_status_text(const HotsReport& h) {
 
 /// stages.hots: the odometry that fed it, the graph's and the time synchronisation's statistics
 /// and the spread-against-offset curve.
-inline io::Json hots_to_json(const HotsReport& h) {
+inline Json hots_to_json(const HotsReport& h) {
   const hots::RefineStatistics& s = h.statistics;
-  io::Json j = io::Json::object();
+  Json j = Json::object();
   j["status"] = hots_status_text(h);
   j["reason"] = h.reason;
   // Skipped for want of frames: no odometry ran either.
@@ -152,8 +151,8 @@ inline io::Json hots_to_json(const HotsReport& h) {
   j["odometry_failed_steps"] = h.odometry_failed_steps;
   j["frames_base"] = h.frames_base;
   j["frames_target"] = h.frames_target;
-  j["initial_T_base_target"] = io::matrix_to_json(h.initial.matrix());
-  j["graph_T_base_target"] = io::matrix_to_json(s.graph_extrinsic.matrix());
+  j["initial_T_base_target"] = matrix_to_json(h.initial.matrix());
+  j["graph_T_base_target"] = matrix_to_json(s.graph_extrinsic.matrix());
   j["windows"] = s.windows;
   j["failed_windows"] = s.failed_windows;
   j["planes"] = s.planes;
@@ -178,19 +177,19 @@ inline io::Json hots_to_json(const HotsReport& h) {
   j["time_offset_refined"] = s.sequence.time_offset_refined;
   j["time_offset_checked"] = s.sequence.time_offset_checked;
   j["time_offset_trusted"] = s.sequence.time_offset_trusted;
-  io::Json halves = io::Json::array();
+  Json halves = Json::array();
   for (const double half : s.sequence.half_time_offset_s) halves.push_back(half);
   j["half_time_offsets_s"] = std::move(halves);
   j["time_observability"] = s.sequence.time_observability;
-  io::Json curve = io::Json::array();
+  Json curve = Json::array();
   for (const auto& [offset, spread] : h.spread_curve) {
-    io::Json point = io::Json::array();
+    Json point = Json::array();
     point.push_back(offset);
     point.push_back(spread);
     curve.push_back(std::move(point));
   }
   j["spread_curve"] = std::move(curve);  // [[offset_s, spread], ...]
-  io::Json phases = io::Json::object();
+  Json phases = Json::object();
   phases["prepare"] = s.prepare_seconds;
   phases["hierarchy"] = s.hierarchy_seconds;
   phases["cross_links"] = s.links_seconds;
@@ -204,9 +203,9 @@ inline io::Json hots_to_json(const HotsReport& h) {
 }
 
 /// The result-file entry for target `target` against base `base`.
-inline io::PairResult to_pair_result(const PairCalibration& c, const std::string& base,
-                                     const std::string& target) {
-  io::PairResult r;
+inline PairResult to_pair_result(const PairCalibration& c, const std::string& base,
+                                 const std::string& target) {
+  PairResult r;
   r.base = base;
   r.target = target;
   r.success = c.success;
@@ -215,11 +214,11 @@ inline io::PairResult to_pair_result(const PairCalibration& c, const std::string
   r.T_base_target = c.T_base_target;
   r.time_offset_s = c.time_offset_s;
   if (c.covariance_6x6) r.covariance_6x6 = *c.covariance_6x6;
-  r.stages = io::Json::object();
+  r.stages = Json::object();
   if (c.terra) r.stages["terra"] = terra_to_json(*c.terra);
   if (c.jeep) r.stages["jeep"] = jeep_to_json(*c.jeep);
   if (c.hots) r.stages["hots"] = hots_to_json(*c.hots);
-  r.timing_s = io::Json::object();
+  r.timing_s = Json::object();
   r.timing_s["terra"] = c.timing_s.terra;
   r.timing_s["jeep"] = c.timing_s.jeep;
   r.timing_s["odometry"] = c.timing_s.odometry;
@@ -228,4 +227,4 @@ inline io::PairResult to_pair_result(const PairCalibration& c, const std::string
   return r;
 }
 
-}  // namespace ulc
+}  // namespace ulc::io
