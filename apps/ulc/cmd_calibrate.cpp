@@ -139,6 +139,212 @@ void print_cycle(const io::CycleResult& c) {
                 c.status.c_str(), c.reason.c_str());
 }
 
+/// What the command line of `ulc calibrate` says.
+struct CalibrateArgs {
+  std::string base_spec, output, format = "json", merged_cloud, report_png,
+                                 stages_text = "terra,jeep,hots", initial;
+  std::vector<std::string> target_specs;
+  long long frame_index = 0, frames = static_cast<long long>(jeep::JeepOptions{}.frames),
+            threads = 0;
+  bool synced_clocks = false, no_route = false, no_cycles = false, quiet = false;
+  InputArgs input;
+  // Set when the user gave them.
+  CLI::Option *output_option = nullptr, *merged_option = nullptr, *report_option = nullptr,
+              *initial_option = nullptr, *threads_option = nullptr;
+
+  bool has(const CLI::Option* o) const { return o->count() > 0; }
+};
+
+void add_source_options(CLI::App& app, CalibrateArgs& a) {
+  app.add_option(
+         "--base", a.base_spec,
+         "the base LiDAR: a frame folder, a cloud file, or FILE:TOPIC of a recording (.bag, "
+         ".mcap, rosbag2 folder, .db3); add =NAME to name it")
+      ->type_name("SOURCE")
+      ->required();
+  app.add_option("--target", a.target_specs, "a target LiDAR, as --base (repeatable)")
+      ->type_name("SOURCE")
+      ->required()
+      ->allow_extra_args(false);
+  add_input_options(app, a.input);
+}
+
+void add_output_options(CLI::App& app, CalibrateArgs& a) {
+  a.output_option =
+      app.add_option("--output", a.output, "write the result file (docs/design.md) here")
+          ->type_name("FILE");
+  app.add_option("--format", a.format,
+                 "format of --output (default json; yaml adds ROS and URDF forms of each "
+                 "extrinsic)")
+      ->check(CLI::IsMember({"json", "yaml"}));
+  a.merged_option =
+      app.add_option("--merged-cloud", a.merged_cloud,
+                     "write every LiDAR's first used frame in the base frame, one colour per LiDAR")
+          ->type_name("PCD");
+  a.report_option =
+      app.add_option("--report", a.report_png,
+                     "draw the fused frames before (initial guess) and after calibration")
+          ->type_name("PNG");
+  app.add_flag("--quiet", a.quiet, "no progress on stderr");
+}
+
+void add_stage_options(CLI::App& app, CalibrateArgs& a) {
+  app.add_option("--stages", a.stages_text,
+                 "an ordered subset of terra,jeep,hots (default terra,jeep,hots)")
+      ->type_name("LIST");
+  a.initial_option =
+      app.add_option("--initial", a.initial,
+                     "\"x y z roll pitch yaw\" (m, deg; R = Rz Ry Rx) or a result file; needed "
+                     "when the stages skip terra")
+          ->type_name("GUESS");
+  app.add_option("--frame-index", a.frame_index,
+                 "TERRA's frame, and the first frame of JEEP and HOTS (default 0)")
+      ->type_name("N")
+      ->check(CLI::Range(0LL, 1000000000LL));
+  app.add_option("--frames", a.frames, "frame pairs JEEP uses (default 5)")
+      ->type_name("K")
+      ->check(CLI::Range(1LL, 100000LL));
+  a.threads_option = app.add_option("--threads", a.threads, "worker threads (default: all cores)")
+                         ->type_name("N")
+                         ->check(CLI::Range(1LL, 1024LL));
+  app.add_flag("--synced-clocks", a.synced_clocks,
+               "the LiDARs' clocks are synchronised (PTP, GPS): HOTS estimates no clock offset "
+               "(for short drives that cannot pin one down)");
+  app.add_flag("--no-route", a.no_route,
+               "do not calibrate a failed target through another target that did calibrate");
+  app.add_flag("--no-cycles", a.no_cycles,
+               "do not check the cycles base -> i -> j -> base (two targets or more)");
+}
+
+/// The pipeline's options from the command line; usage errors before any frame is read.
+CalibrateOptions calibrate_options(const CalibrateArgs& a) {
+  CalibrateOptions options;
+  options.stages = stages_option(a.stages_text);
+  const bool run_terra = has_stage(options.stages, Stage::terra);
+  const bool has_initial = a.has(a.initial_option);
+  if (run_terra && has_initial)
+    throw UsageError(
+        "calibrate: option '--initial' is only used when the stages skip terra (TERRA needs no "
+        "guess); use --stages jeep,hots or hots with it");
+  if (!run_terra && !has_initial)
+    throw UsageError("calibrate: --stages " + stages_to_string(options.stages) +
+                     " needs an initial extrinsic: --initial \"x y z roll pitch yaw\" or "
+                     "--initial FILE.json");
+  if (a.synced_clocks) options.time_offset_s = 0.0;
+  options.tuning.jeep.frames = static_cast<std::size_t>(a.frames);
+  if (!run_terra) (void)parse_initial(a.initial, "", "");  // fail before any loading
+  for (const CLI::Option* file_option : {a.output_option, a.merged_option, a.report_option})
+    if (a.has(file_option)) require_output_folder(file_option->as<std::string>());
+  return options;
+}
+
+/// Every LiDAR's frames from frame_index, as many as the stages need, held for the whole rig
+/// (routes and cycles pair targets too); the base's are shared by all targets.
+struct LoadedRig {
+  std::vector<std::unique_ptr<LidarInput>> inputs;
+  std::vector<LoadedFrames> frames;  ///< the base's first
+  std::vector<RigLidar<std::vector<PointCloud<float>>>> lidars;
+};
+
+LoadedRig load_rig(const CalibrateArgs& a, const CalibrateOptions& options) {
+  const bool run_jeep = has_stage(options.stages, Stage::jeep);
+  const bool run_hots = has_stage(options.stages, Stage::hots);
+  const auto frame_index = static_cast<std::size_t>(a.frame_index);
+  std::vector<LidarSpec> specs{parse_lidar_spec(a.base_spec, "calibrate", "base")};
+  for (const auto& t : a.target_specs) specs.push_back(parse_lidar_spec(t, "calibrate", "target"));
+  LoadedRig rig;
+  rig.inputs = open_lidar_inputs(specs, input_options(a.input, "calibrate"), "calibrate");
+  print_input_warnings(rig.inputs, "calibrate");
+  const LidarInput& base = *rig.inputs.front();
+  const std::size_t base_count = run_hots ? kAllFrames : run_jeep ? options.tuning.jeep.frames : 1;
+  for (std::size_t k = 0; k < rig.inputs.size(); ++k) {
+    const LidarInput& lidar = *rig.inputs[k];
+    const std::size_t count = k == 0 || run_hots ? base_count
+                              : run_jeep ? covering_count(base.period(), lidar.period(), base_count)
+                                         : 1;
+    rig.frames.push_back(lidar.load(frame_index, count));
+    require_frame(lidar, rig.frames.back(), frame_index);
+  }
+  for (std::size_t k = 0; k < rig.inputs.size(); ++k) {
+    RigLidar<std::vector<PointCloud<float>>> l{
+        rig.inputs[k]->name(), &rig.frames[k].clouds, &rig.frames[k].times, {}};
+    if (k > 0 && !has_stage(options.stages, Stage::terra))
+      l.initial = parse_initial(a.initial, base.name(), l.name);
+    rig.lidars.push_back(std::move(l));
+  }
+  return rig;
+}
+
+RigCalibration run_rig(const CalibrateArgs& a, const CalibrateOptions& options,
+                       const LoadedRig& loaded) {
+  RigOptions rig_options;
+  rig_options.pair = options;
+  rig_options.pair.frame_index = 0;  // the loaded frames start at frame_index
+  rig_options.route = !a.no_route;
+  rig_options.cycles = !a.no_cycles && loaded.inputs.size() >= 3;
+  rig_options.cycle_stages = cycle_stages(options.stages);
+  StageProgress progress(a.quiet);
+  rig_options.pair.progress = [&progress](const std::string& stage, double f) {
+    progress(stage, f);
+  };
+  auto run = [&] { return calibrate_rig(loaded.lidars, 0, rig_options); };
+  std::optional<tbb::task_arena> arena;
+  if (a.has(a.threads_option)) arena.emplace(static_cast<int>(a.threads));
+  RigCalibration rig = arena ? arena->execute(run) : run();
+  if (rig.status == RigStatus::invalid_input) throw UsageError("calibrate: " + rig.reason);
+  return rig;
+}
+
+/// The result file's entries, printed as they are made, and the pictures' clouds: a failed
+/// target is drawn where its guess put it, in both panels.
+struct RigOutputs {
+  std::vector<io::PairResult> results;
+  std::vector<io::CycleResult> cycles;
+  std::vector<FusedPart> fused;
+  std::vector<ReportCloud> report;
+};
+
+RigOutputs rig_outputs(const CalibrateArgs& a, const LoadedRig& loaded, const RigCalibration& rig) {
+  const std::string& base = loaded.lidars.front().name;
+  RigOutputs out;
+  out.fused.push_back({points_of(loaded.frames.front().clouds.front()), Isometry3d::Identity()});
+  out.report.push_back(
+      {base, out.fused.front().points, Isometry3d::Identity(), Isometry3d::Identity()});
+  const bool pictures = a.has(a.merged_option) || a.has(a.report_option);
+  for (const RigTarget& t : rig.targets) {
+    out.results.push_back(rig_entry(t, base, static_cast<std::size_t>(a.frame_index)));
+    print_summary(out.results.back());
+    if (!pictures) continue;
+    const Isometry3d before = loaded.lidars[t.lidar].initial.value_or(Isometry3d::Identity());
+    const Isometry3d after = t.ok() ? t.result.T_base_target : before;
+    out.fused.push_back({points_of(loaded.frames[t.lidar].clouds.front()), after});
+    out.report.push_back({t.name, out.fused.back().points, before, after});
+  }
+  for (const RigCycle& c : rig.cycles) {
+    out.cycles.push_back(cycle_entry(c, base));
+    print_cycle(out.cycles.back());
+  }
+  return out;
+}
+
+void write_outputs(const CalibrateArgs& a, const RigOutputs& out) {
+  if (a.has(a.output_option)) {
+    if (a.format == "yaml")
+      io::write_result_yaml(a.output, out.results, out.cycles);
+    else
+      io::write_result_file(a.output, out.results, out.cycles);
+    std::printf("wrote %s\n", a.output.c_str());
+  }
+  if (a.has(a.merged_option)) {
+    write_fused_cloud(a.merged_cloud, out.fused);
+    std::printf("wrote %s\n", a.merged_cloud.c_str());
+  }
+  if (a.has(a.report_option)) {
+    write_calibration_report(a.report_png, out.report);
+    std::printf("wrote %s\n", a.report_png.c_str());
+  }
+}
+
 }  // namespace
 
 int run_calibrate(int argc, char** argv) {
@@ -151,172 +357,17 @@ int run_calibrate(int argc, char** argv) {
       "Exit 0: every target calibrated, directly or through another; 1: some did not (the result "
       "file says why); 2: bad usage or input.",
       "ulc calibrate");
-  std::string base_spec, output, format = "json", merged_cloud, report_png,
-                                 stages_text = "terra,jeep,hots", initial;
-  std::vector<std::string> target_specs;
-  long long frame_index_arg = 0, frames = 0, threads = 0;
-  bool synced_clocks = false, no_route = false, no_cycles = false, quiet = false;
-  CalibrateOptions options;
-  frames = static_cast<long long>(options.tuning.jeep.frames);
-  app.add_option(
-         "--base", base_spec,
-         "the base LiDAR: a frame folder, a cloud file, or FILE:TOPIC of a recording (.bag, "
-         ".mcap, rosbag2 folder, .db3); add =NAME to name it")
-      ->type_name("SOURCE")
-      ->required();
-  app.add_option("--target", target_specs, "a target LiDAR, as --base (repeatable)")
-      ->type_name("SOURCE")
-      ->required()
-      ->allow_extra_args(false);
-  auto* output_option =
-      app.add_option("--output", output, "write the result file (docs/design.md) here")
-          ->type_name("FILE");
-  app.add_option("--format", format,
-                 "format of --output (default json; yaml adds ROS and URDF forms of each "
-                 "extrinsic)")
-      ->check(CLI::IsMember({"json", "yaml"}));
-  auto* merged_option =
-      app.add_option("--merged-cloud", merged_cloud,
-                     "write every LiDAR's first used frame in the base frame, one colour per LiDAR")
-          ->type_name("PCD");
-  auto* report_option =
-      app.add_option("--report", report_png,
-                     "draw the fused frames before (initial guess) and after calibration")
-          ->type_name("PNG");
-  app.add_option("--stages", stages_text,
-                 "an ordered subset of terra,jeep,hots (default terra,jeep,hots)")
-      ->type_name("LIST");
-  auto* initial_option =
-      app.add_option("--initial", initial,
-                     "\"x y z roll pitch yaw\" (m, deg; R = Rz Ry Rx) or a result file; needed "
-                     "when the stages skip terra")
-          ->type_name("GUESS");
-  app.add_option("--frame-index", frame_index_arg,
-                 "TERRA's frame, and the first frame of JEEP and HOTS (default 0)")
-      ->type_name("N")
-      ->check(CLI::Range(0LL, 1000000000LL));
-  app.add_option("--frames", frames, "frame pairs JEEP uses (default 5)")
-      ->type_name("K")
-      ->check(CLI::Range(1LL, 100000LL));
-  auto* threads_option = app.add_option("--threads", threads, "worker threads (default: all cores)")
-                             ->type_name("N")
-                             ->check(CLI::Range(1LL, 1024LL));
-  InputArgs input_args;
-  add_input_options(app, input_args);
-  app.add_flag("--synced-clocks", synced_clocks,
-               "the LiDARs' clocks are synchronised (PTP, GPS): HOTS estimates no clock offset "
-               "(for short drives that cannot pin one down)");
-  app.add_flag("--no-route", no_route,
-               "do not calibrate a failed target through another target that did calibrate");
-  app.add_flag("--no-cycles", no_cycles,
-               "do not check the cycles base -> i -> j -> base (two targets or more)");
-  app.add_flag("--quiet", quiet, "no progress on stderr");
+  CalibrateArgs args;
+  add_source_options(app, args);
+  add_output_options(app, args);
+  add_stage_options(app, args);
   if (parse_command_line(app, "calibrate", argc, argv)) return kExitOk;
-
-  options.stages = stages_option(stages_text);
-  const bool run_terra = has_stage(options.stages, Stage::terra);
-  const bool run_jeep = has_stage(options.stages, Stage::jeep);
-  const bool run_hots = has_stage(options.stages, Stage::hots);
-  const bool has_initial = initial_option->count() > 0;
-  if (run_terra && has_initial)
-    throw UsageError(
-        "calibrate: option '--initial' is only used when the stages skip terra (TERRA needs no "
-        "guess); use --stages jeep,hots or hots with it");
-  if (!run_terra && !has_initial)
-    throw UsageError("calibrate: --stages " + stages_to_string(options.stages) +
-                     " needs an initial extrinsic: --initial \"x y z roll pitch yaw\" or "
-                     "--initial FILE.json");
-  if (synced_clocks) options.time_offset_s = 0.0;
-  const auto frame_index = static_cast<std::size_t>(frame_index_arg);
-  options.tuning.jeep.frames = static_cast<std::size_t>(frames);
-  std::optional<tbb::task_arena> arena;
-  if (threads_option->count() > 0) arena.emplace(static_cast<int>(threads));
-  if (!run_terra) (void)parse_initial(initial, "", "");  // fail before any loading
-  for (const CLI::Option* file_option : {output_option, merged_option, report_option})
-    if (file_option->count() > 0) require_output_folder(file_option->as<std::string>());
-
-  std::vector<LidarSpec> specs{parse_lidar_spec(base_spec, "calibrate", "base")};
-  for (const auto& t : target_specs) specs.push_back(parse_lidar_spec(t, "calibrate", "target"));
-  const auto inputs = open_lidar_inputs(specs, input_options(input_args, "calibrate"), "calibrate");
-  print_input_warnings(inputs, "calibrate");
-  const LidarInput& base = *inputs.front();
-
-  // The frames each stage needs, counted from frame_index; the base's are shared by all targets.
-  const std::size_t base_count = run_hots ? kAllFrames : run_jeep ? options.tuning.jeep.frames : 1;
-  const LoadedFrames base_frames = base.load(frame_index, base_count);
-  require_frame(base, base_frames, frame_index);
-
-  // Every LiDAR's frames are held for the whole rig: routes and cycles pair targets too.
-  std::vector<LoadedFrames> target_frames;
-  for (std::size_t k = 1; k < inputs.size(); ++k) {
-    const std::size_t count = run_hots ? kAllFrames
-                              : run_jeep
-                                  ? covering_count(base.period(), inputs[k]->period(), base_count)
-                                  : 1;
-    target_frames.push_back(inputs[k]->load(frame_index, count));
-    require_frame(*inputs[k], target_frames.back(), frame_index);
-  }
-  using Frames = std::vector<PointCloud<float>>;
-  std::vector<RigLidar<Frames>> lidars{{base.name(), &base_frames.clouds, &base_frames.times, {}}};
-  for (std::size_t k = 0; k + 1 < inputs.size(); ++k) {
-    RigLidar<Frames> l{
-        inputs[k + 1]->name(), &target_frames[k].clouds, &target_frames[k].times, {}};
-    if (!run_terra) l.initial = parse_initial(initial, base.name(), l.name);
-    lidars.push_back(std::move(l));
-  }
-  RigOptions rig_options;
-  rig_options.pair = options;
-  rig_options.pair.frame_index = 0;  // the loaded frames start at frame_index
-  rig_options.route = !no_route;
-  rig_options.cycles = !no_cycles && inputs.size() >= 3;
-  rig_options.cycle_stages = cycle_stages(options.stages);
-  StageProgress progress(quiet);
-  rig_options.pair.progress = [&progress](const std::string& stage, double f) {
-    progress(stage, f);
-  };
-  auto run = [&] { return calibrate_rig(lidars, 0, rig_options); };
-  const RigCalibration rig = arena ? arena->execute(run) : run();
-  if (rig.status == RigStatus::invalid_input) throw UsageError("calibrate: " + rig.reason);
-
-  std::vector<io::PairResult> results;
-  std::vector<FusedPart> fused{{points_of(base_frames.clouds.front()), Isometry3d::Identity()}};
-  std::vector<ReportCloud> report{
-      {base.name(), fused.front().points, Isometry3d::Identity(), Isometry3d::Identity()}};
-  for (std::size_t k = 0; k < rig.targets.size(); ++k) {
-    const RigTarget& t = rig.targets[k];
-    results.push_back(rig_entry(t, base.name(), frame_index));
-    print_summary(results.back());
-    if (merged_option->count() > 0 || report_option->count() > 0) {
-      // Pictures show the calibrated frames only when they are worth showing; a failed target is
-      // drawn where its guess put it, in both panels.
-      const Isometry3d before = lidars[t.lidar].initial.value_or(Isometry3d::Identity());
-      const Isometry3d after = t.ok() ? t.result.T_base_target : before;
-      fused.push_back({points_of(target_frames[k].clouds.front()), after});
-      report.push_back({t.name, fused.back().points, before, after});
-    }
-  }
-  std::vector<io::CycleResult> cycles;
-  for (const RigCycle& c : rig.cycles) {
-    cycles.push_back(cycle_entry(c, base.name()));
-    print_cycle(cycles.back());
-  }
-
-  if (output_option->count() > 0) {
-    if (format == "yaml")
-      io::write_result_yaml(output, results, cycles);
-    else
-      io::write_result_file(output, results, cycles);
-    std::printf("wrote %s\n", output.c_str());
-  }
-  if (merged_option->count() > 0) {
-    write_fused_cloud(merged_cloud, fused);
-    std::printf("wrote %s\n", merged_cloud.c_str());
-  }
-  if (report_option->count() > 0) {
-    write_calibration_report(report_png, report);
-    std::printf("wrote %s\n", report_png.c_str());
-  }
-  for (const auto& r : results)
+  const CalibrateOptions options = calibrate_options(args);
+  const LoadedRig loaded = load_rig(args, options);
+  const RigCalibration rig = run_rig(args, options, loaded);
+  const RigOutputs out = rig_outputs(args, loaded, rig);
+  write_outputs(args, out);
+  for (const auto& r : out.results)
     if (!r.success) return kExitFailed;
   return kExitOk;
 }
