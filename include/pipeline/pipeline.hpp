@@ -13,40 +13,34 @@
 //   - Inputs: the frames of each LiDAR (any random-access container of clouds with point traits,
 //     per-point times relative to the frame timestamp) and their timestamps (seconds, each
 //     LiDAR's own clock, one per frame).
-//   - frame_index i: TERRA uses frame i of each LiDAR (the same index, so clock offsets do not
-//     matter), or each LiDAR's local map over a window from frame i on (map_terra.hpp), as
-//     CalibrateOptions::tuning.terra_source.source says. automatic runs the frame search first and
-//     keeps it unless the sequences hold at least terra_maps_min_frames frames per LiDAR in the
-//     window AND the frame search failed or overlaps in fewer than terra_maps_below_mask cells;
-//     then the map search runs and wins when it succeeds with a larger mask. stages.terra says
-//     which
-//     ("source") and why. JEEP pairs frames by timestamp from frame i of each on and uses the first
+//   - frame_index i: TERRA uses frame i of each LiDAR, or each LiDAR's local map over a window
+//     from frame i on, as tuning.terra_source says (terra_stage.hpp; stages.terra says which
+//     and why). JEEP pairs frames by timestamp from frame i of each on and uses the first
 //     JeepOptions::frames pairs. Frames before i are never touched.
 //   - Stages: any ordered subset of terra, jeep, hots (stages.hpp); the default is all three
 //     (docs/design.md). TERRA needs no prior and ignores `initial`; each later stage starts from
 //     the previous stage's extrinsic, or from `initial` when it is the first, which is then
 //     required (status initial_required without it).
-//   - HOTS: multi-LiDAR odometry (options.tuning.odometry) over ALL frames of each LiDAR from frame
-//   i
-//     on, with the extrinsic HOTS starts from, then hots::refine (options.tuning.hots) on those
+//   - HOTS: multi-LiDAR odometry (tuning.odometry) over ALL frames of each LiDAR from frame i
+//     on, with the extrinsic HOTS starts from, then hots::refine (tuning.hots) on those
 //     frames and poses. Its extrinsic, clock offset and covariance become the result's. An odometry
 //     that could not register some frames still feeds HOTS (its poses are predictions there;
 //     the report counts them); an odometry that gives no poses, or a HOTS that fails, ends the
 //     call with hots_failed, keeping the previous extrinsic. With fewer than
-//     hots_min_frames frames per LiDAR (single frames, as in a static rig's snapshot) HOTS is
-//     skipped after TERRA or JEEP: stages.hots has status "skipped" and the reason. A HOTS
-//     whose clock offset the drive does not pin down fails too (time_offset_untrusted: the
-//     extrinsic would carry the offset's error times the speed); a caller who knows the
-//     clocks' offset sets time_offset_s, and then no offset is estimated or checked.
+//     tuning.hots_min_frames frames per LiDAR (single frames, as in a static rig's snapshot) HOTS
+//     is skipped after TERRA or JEEP: stages.hots has status "skipped" and the reason. A HOTS whose
+//     clock offset the drive does not pin down fails too (time_offset_untrusted: the extrinsic
+//     would carry the offset's error times the speed); a caller who knows the clocks' offset sets
+//     time_offset_s, and then no offset is estimated or checked.
 //   - TERRA's hypotheses and HOTS as the judge (not in the paper): with HOTS on a moving rig,
-//     a JEEP that was rejected or did not settle hands its extrinsic to HOTS (hots_judges_jeep),
-//     and when the attempt from TERRA's best rotation fails in a way that points at the
-//     rotation (JEEP failed, or HOTS's extrinsic_unconfirmed), TERRA's next distinct optima run
-//     in turn (terra_hypotheses); the first success wins. When all of those fail, up to
-//     terra_fallback_hypotheses more (the kept search's other optima, then those of the search
-//     not kept) run, each needing JEEP's own acceptance before HOTS. With none, the best one's
-//     failure is reported. stages.terra.hypotheses lists each one tried and its outcome; timings
-//     sum over all of them.
+//     a JEEP that was rejected or did not settle hands its extrinsic to HOTS
+//     (tuning.hypotheses.hots_judges_jeep), and when the attempt from TERRA's best rotation fails
+//     in a way that points at the rotation (JEEP failed, or HOTS's extrinsic_unconfirmed), TERRA's
+//     next distinct optima run in turn (up to tuning.hypotheses.count); the first success wins.
+//     When all of those fail, up to tuning.hypotheses.fallback more (the kept search's other
+//     optima, then those of the search not kept) run, each needing JEEP's own acceptance before
+//     HOTS. With none, the best one's failure is reported. stages.terra.hypotheses lists each one
+//     tried and its outcome; timings sum over all of them.
 //   - Progress: options.progress(stage, fraction in [0, 1]) on the calling thread; stages
 //     "terra", "jeep", "odometry", "hots" (HOTS reports only 0 and 1); a later hypothesis's
 //     stages carry " (hypothesis k)".
