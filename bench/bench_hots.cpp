@@ -289,6 +289,8 @@ Run one_run(const std::string& scenario, double offset_s, std::size_t run, const
     ulc::CalibrateOptions o;
     o.stages = {ulc::Stage::jeep};
     o.initial = initial;
+    // HOTS, run next, estimates the clock offset: JEEP's own result need not vouch for one.
+    o.tuning.vouch.enabled = false;
     if (c.layers > 0) o.tuning.hots.hierarchy.layers = c.layers;
     for (const auto& setting : c.hots_settings) apply_hots_setting(o.tuning.hots, setting);
     const auto j = ulc::calibrate_pair(a.frames, a.timestamps, b.frames, times_b, o);

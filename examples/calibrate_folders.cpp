@@ -61,6 +61,10 @@ int main(int argc, char** argv) {
     ulc::CalibrateOptions options;  // the paper's defaults
     // TERRA (no guess) then JEEP on the first frames; add ulc::Stage::hots for a long drive.
     options.stages = {ulc::Stage::terra, ulc::Stage::jeep};
+    // Without HOTS nobody estimates the clocks' offset: the simulator's are synchronised.
+    // Otherwise leave it unset and give JEEP enough frames for the clock check
+    // (pipeline/vouch.hpp), or add HOTS.
+    options.time_offset_s = 0.0;
     options.progress = [](const std::string& stage, double fraction) {
       if (fraction == 1.0) std::fprintf(stderr, "%s done\n", stage.c_str());
     };

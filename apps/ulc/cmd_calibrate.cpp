@@ -4,6 +4,7 @@
 // through one that succeeded, and with two targets or more the cycles between them are closed.
 #include <tbb/task_arena.h>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -122,6 +123,17 @@ void print_summary(const io::PairResult& r) {
   if (const io::Json* hots = io::find_member(r.stages, "hots");
       hots && hots->at("status").get<std::string>() != "skipped")
     std::printf("  time_offset_ms %.2f\n", r.time_offset_s ? *r.time_offset_s * 1e3 : 0.0);
+  // What the data could not vouch for (pipeline/vouch.hpp), when it applies.
+  if (r.success && !r.clock.is_null() && r.clock.at("source").get<std::string>() == "not_estimated")
+    std::printf("  clock   %s\n", r.clock.at("note").get<std::string>().c_str());
+  if (r.point_times.is_object())
+    for (const char* lidar : {"base", "target"})
+      if (const io::Json& p = r.point_times.at(lidar);
+          p.at("source").get<std::string>() != "per_point")
+        std::printf("  times   %s (%s): %s\n",
+                    lidar == std::string("base") ? r.base.c_str() : r.target.c_str(),
+                    p.at("source").get<std::string>().c_str(),
+                    p.at("note").get<std::string>().c_str());
   std::printf("  time_s  terra %.2f  jeep %.2f  odometry %.2f  hots %.2f  total %.2f\n",
               r.timing_s.at("terra").get<double>(), r.timing_s.at("jeep").get<double>(),
               r.timing_s.at("odometry").get<double>(), r.timing_s.at("hots").get<double>(),
@@ -151,6 +163,8 @@ struct CalibrateArgs {
   // Set when the user gave them.
   CLI::Option *output_option = nullptr, *merged_option = nullptr, *report_option = nullptr,
               *initial_option = nullptr, *threads_option = nullptr;
+  double time_offset = 0.0;  ///< --time-offset: a known offset of every target's clock
+  CLI::Option* time_offset_option = nullptr;
 
   bool has(const CLI::Option* o) const { return o->count() > 0; }
 };
@@ -210,6 +224,13 @@ void add_stage_options(CLI::App& app, CalibrateArgs& a) {
   app.add_flag("--synced-clocks", a.synced_clocks,
                "the LiDARs' clocks are synchronised (PTP, GPS): HOTS estimates no clock offset "
                "(for short drives that cannot pin one down)");
+  a.time_offset_option =
+      app.add_option(
+             "--time-offset", a.time_offset,
+             "the clocks' known offset, t_base = t_target + S, [-1, 1] s, for every target: "
+             "no offset is estimated or checked")
+          ->type_name("S")
+          ->excludes("--synced-clocks");
   app.add_flag("--no-route", a.no_route,
                "do not calibrate a failed target through another target that did calibrate");
   app.add_flag("--no-cycles", a.no_cycles,
@@ -231,6 +252,11 @@ CalibrateOptions calibrate_options(const CalibrateArgs& a) {
                      " needs an initial extrinsic: --initial \"x y z roll pitch yaw\" or "
                      "--initial FILE.json");
   if (a.synced_clocks) options.time_offset_s = 0.0;
+  if (a.has(a.time_offset_option)) {
+    if (!(std::fabs(a.time_offset) <= 1.0))
+      throw UsageError("calibrate: option '--time-offset' must be within [-1, 1] s");
+    options.time_offset_s = a.time_offset;
+  }
   options.tuning.jeep.frames = static_cast<std::size_t>(a.frames);
   if (!run_terra) (void)parse_initial(a.initial, "", "");  // fail before any loading
   for (const CLI::Option* file_option : {a.output_option, a.merged_option, a.report_option})
@@ -256,7 +282,9 @@ LoadedRig load_rig(const CalibrateArgs& a, const CalibrateOptions& options) {
   rig.inputs = open_lidar_inputs(specs, input_options(a.input, "calibrate"), "calibrate");
   print_input_warnings(rig.inputs, "calibrate");
   const LidarInput& base = *rig.inputs.front();
-  const std::size_t base_count = run_hots ? kAllFrames : run_jeep ? options.tuning.jeep.frames : 1;
+  const std::size_t base_count = run_hots   ? kAllFrames
+                                 : run_jeep ? jeep_only_count(options, base.period())
+                                            : 1;
   for (std::size_t k = 0; k < rig.inputs.size(); ++k) {
     const LidarInput& lidar = *rig.inputs[k];
     const std::size_t count = k == 0 || run_hots ? base_count

@@ -1,9 +1,11 @@
 // `ulc simulate`: writes a dataset folder (docs/design.md) for a named rig and scene, with exact
 // ground truth, and optionally a top-down preview of every LiDAR's first frame.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "command_line.hpp"
 #include "commands.hpp"
@@ -13,6 +15,7 @@
 #include "ulc/sim/dataset_writer.hpp"
 #include "ulc/sim/scenario.hpp"
 #include "ulc/sim/simulate.hpp"
+#include "usage_error.hpp"
 
 namespace ulc::app {
 namespace {
@@ -63,6 +66,25 @@ void write_preview(const std::string& png, const std::filesystem::path& dir,
   image.write_png(png);
 }
 
+/// Writes every frame of the named LiDARs again without their per-point times: a driver that does
+/// not publish them, or a conversion that dropped them.
+void strip_point_times(const std::filesystem::path& dir, const sim::Dataset& dataset,
+                       const std::vector<std::string>& names) {
+  for (const std::string& name : names) {
+    const auto it = std::find_if(dataset.lidars.begin(), dataset.lidars.end(),
+                                 [&](const auto& l) { return l.name == name; });
+    if (it == dataset.lidars.end())
+      throw UsageError("simulate: --no-point-times: no LiDAR named '" + name + "' in " +
+                       dataset.scenario);
+    for (std::size_t k = 0; k < it->timestamps.size(); ++k) {
+      const auto file = dir / name / sim::frame_file_name(k);
+      auto cloud = io::read_pcd<PointCloud<float>>(file);
+      cloud.times.clear();
+      io::write_pcd(file, cloud, io::PcdEncoding::binary);
+    }
+  }
+}
+
 void print_scenarios() {
   for (const auto& name : sim::scenario_names()) {
     const auto spec = sim::scenario(name);
@@ -81,6 +103,7 @@ int run_simulate(int argc, char** argv) {
   double seconds = 20.0, rate = 10.0, time_offset = 0.0, steering_ramp = 0.0;
   long long seed = 1;
   bool list = false, quiet = false;
+  std::vector<std::string> untimed;
   // --scenario and --out are required unless --list: checked after parsing.
   auto* scenario_option =
       app.add_option("--scenario", scenario_name, "a rig and scene (see --list)")
@@ -109,6 +132,9 @@ int run_simulate(int argc, char** argv) {
   auto* preview_option =
       app.add_option("--preview", preview, "also draw every LiDAR's first frame, top-down and side")
           ->type_name("PNG");
+  app.add_option("--no-point-times", untimed,
+                 "write this LiDAR's frames without per-point times (repeatable)")
+      ->type_name("LIDAR");
   app.add_flag("--list", list, "list the scenarios and exit");
   app.add_flag("--quiet", quiet, "no progress on stderr");
   if (parse_command_line(app, "simulate", argc, argv)) return kExitOk;
@@ -155,6 +181,7 @@ int run_simulate(int argc, char** argv) {
     std::fprintf(stderr, "ulc simulate: %s\n", result.reason.c_str());
     return kExitUsage;
   }
+  strip_point_times(out, result.dataset, untimed);
   std::printf("wrote %s: scenario %s, %.1f s, seed %llu\n", out.string().c_str(),
               spec->name.c_str(), options.seconds, static_cast<unsigned long long>(options.seed));
   for (const auto& l : result.dataset.lidars)

@@ -15,6 +15,7 @@
 //   - Progress: "jeep", "odometry", "hots", with the attempt's label (" (hypothesis k)").
 #pragma once
 
+#include <algorithm>
 #include <chrono>
 #include <cstddef>
 #include <optional>
@@ -79,6 +80,16 @@ inline odometry::ProgressFn count_progress(const CalibrateOptions& o, std::strin
   };
 }
 
+/// The target's largest speed over JEEP's pairs: a's body twists (per second) carried to b's
+/// origin, |rho + phi x t| with t the extrinsic's translation.
+inline double target_speed(const jeep::JeepResult& j) {
+  double fastest = 0.0;
+  for (const Vec6d& xi : j.twists)
+    fastest =
+        std::max(fastest, (xi.head<3>() + xi.tail<3>().cross(j.extrinsic.translation())).norm());
+  return fastest;
+}
+
 inline JeepReport jeep_report(const jeep::JeepResult& j, const Isometry3d& initial,
                               double seconds) {
   JeepReport r;
@@ -102,6 +113,7 @@ inline JeepReport jeep_report(const jeep::JeepResult& j, const Isometry3d& initi
   r.start_basins = j.start_search.basins;
   r.start_chosen = j.start_search.chosen;
   r.seconds = seconds;
+  r.target_speed_mps = target_speed(j);
   return r;
 }
 

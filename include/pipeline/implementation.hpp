@@ -5,13 +5,21 @@
 
 #include "pipeline/calibrate.hpp"
 #include "pipeline/pipeline.hpp"
+#include "pipeline/point_times.hpp"
 
 namespace ulc {
 
 PairCalibration calibrate_pair(const FloatFrames& frames_a, const std::vector<double>& times_a,
                                const FloatFrames& frames_b, const std::vector<double>& times_b,
                                const CalibrateOptions& options) {
-  return calibrate_pair_in_place(frames_a, times_a, frames_b, times_b, options);
+  // A LiDAR without per-point times gets them from azimuth when it spins (point_times.hpp).
+  TimedFrames a, b;
+  fill_point_times(frames_a, times_a, options.frame_index, a);
+  fill_point_times(frames_b, times_b, options.frame_index, b);
+  PairCalibration r = calibrate_pair_in_place(*a.frames, times_a, *b.frames, times_b, options);
+  report_point_times(a, r.point_times_base);
+  report_point_times(b, r.point_times_target);
+  return r;
 }
 
 }  // namespace ulc

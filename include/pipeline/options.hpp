@@ -18,6 +18,7 @@
 #include "pipeline/hypothesis_options.hpp"
 #include "pipeline/map_terra_options.hpp"
 #include "pipeline/stages.hpp"
+#include "pipeline/vouch_options.hpp"
 #include "terra/search_params.hpp"
 #include "ulc/core/types.hpp"
 
@@ -39,6 +40,9 @@ struct StageTuning {
   /// has no motion to work with, so after TERRA or JEEP it is skipped (stages.hots says so) and
   /// their extrinsic is the answer; as the only stage it fails.
   std::size_t hots_min_frames = 10;
+  /// What the data cannot vouch for: an unestimated clock offset, frames without point times
+  /// (pipeline/vouch.hpp).
+  VouchOptions vouch;
 };
 
 /// What a caller of calibrate_pair decides.

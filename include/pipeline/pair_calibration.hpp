@@ -37,7 +37,10 @@ enum class CalibrateStatus {
   initial_required,  ///< no terra stage and no initial extrinsic
   terra_failed,      ///< TERRA found no rotation (see terra->status)
   jeep_failed,       ///< JEEP did not converge or its result was rejected (see jeep->status)
-  hots_failed        ///< the odometry before HOTS or HOTS itself failed (see hots->status)
+  hots_failed,       ///< the odometry before HOTS or HOTS itself failed (see hots->status)
+  // What the data cannot vouch for (pipeline/vouch.hpp; the extrinsic is kept for inspection):
+  time_offset_unestimated,  ///< no clock offset estimated or given, and a lag moves it (clock)
+  point_times_missing       ///< a LiDAR's sweeps could not be deskewed at this speed (point_times)
 };
 
 inline const char* to_string(CalibrateStatus s) {
@@ -52,6 +55,10 @@ inline const char* to_string(CalibrateStatus s) {
       return "terra_failed";
     case CalibrateStatus::jeep_failed:
       return "jeep_failed";
+    case CalibrateStatus::time_offset_unestimated:
+      return "time_offset_unestimated";
+    case CalibrateStatus::point_times_missing:
+      return "point_times_missing";
     default:
       return "hots_failed";
   }
@@ -127,6 +134,9 @@ struct JeepReport {
   /// (CalibrateOptions::tuning.hypotheses.hots_judges_jeep): the pair's status says which won.
   bool judged_by_hots = false;
   double seconds = 0.0;
+  /// The target's largest speed over the pairs (a's twists carried to b's origin), m/s: what
+  /// an unestimated clock offset or an undeskewed sweep turns into a translation error.
+  double target_speed_mps = 0.0;
 };
 
 /// How far the HOTS stage got.
@@ -155,6 +165,67 @@ struct HotsReport {
   double seconds = 0.0;  ///< hots::refine alone
 };
 
+// What the data cannot vouch for (pipeline/vouch.hpp, docs/pipeline.md "Clocks and point
+// times"): the clock offset when no stage estimated it, and the LiDARs without per-point times.
+
+/// Where the result's clock offset comes from.
+enum class ClockSource {
+  given,              ///< CalibrateOptions::time_offset_s (--synced-clocks, --time-offset)
+  estimated_by_hots,  ///< HOTS's time synchronisation
+  not_estimated       ///< neither: clocks assumed synchronised; clock.verdict says if it matters
+};
+
+inline const char* to_string(ClockSource s) {
+  switch (s) {
+    case ClockSource::given:
+      return "given";
+    case ClockSource::estimated_by_hots:
+      return "estimated_by_hots";
+    default:
+      return "not_estimated";
+  }
+}
+
+/// The clock offset's effect on a translation nobody synchronised (vouch.hpp).
+struct ClockReport {
+  ClockSource source = ClockSource::not_estimated;
+  double speed_mps = 0.0;             ///< the target's largest speed over JEEP's frames
+  double translation_per_ms_m = 0.0;  ///< how far 1 ms of offset moves the translation
+  /// slow (no plausible offset matters), lag_within_bar, lag_exceeds_bar, lag_unobservable,
+  /// or empty when the source is given or estimated.
+  std::string verdict;
+  bool lag_checked = false;  ///< the lag was estimated from both LiDARs' rotation rates
+  double lag_s = 0.0;        ///< t_base = t_target + lag, as the motions show it (not applied)
+  double lag_sigma_s = 0.0;
+  std::size_t lag_samples = 0;  ///< target frames compared
+  double lag_window_s = 0.0;    ///< seconds of frames the lag was estimated over
+  std::string note;             ///< one plain sentence (the result file's "clock.note")
+};
+
+/// Where a LiDAR's per-point times come from.
+enum class PointTimeSource {
+  per_point,                 ///< the frames carry them
+  synthesised_from_azimuth,  ///< none in the frames; from each point's azimuth (sweep_times.hpp)
+  none                       ///< none: the sweeps are not deskewed
+};
+
+inline const char* to_string(PointTimeSource s) {
+  switch (s) {
+    case PointTimeSource::per_point:
+      return "per_point";
+    case PointTimeSource::synthesised_from_azimuth:
+      return "synthesised_from_azimuth";
+    default:
+      return "none";
+  }
+}
+
+struct PointTimesReport {
+  PointTimeSource source = PointTimeSource::per_point;
+  std::size_t frames_without = 0;  ///< frames (from frame_index) without per-point times
+  std::string note;                ///< what was done, and why (empty for per_point)
+};
+
 struct StageTimings {
   double terra = 0.0;
   double jeep = 0.0;
@@ -177,6 +248,10 @@ struct PairCalibration {
   double time_offset_s = 0.0;
   std::optional<Mat6d> covariance_6x6;
   StageTimings timing_s;
+  // What the data cannot vouch for (vouch.hpp): the clock offset's provenance and effect
+  // (set whenever JEEP's or HOTS's translation is the answer), and each LiDAR's point times.
+  std::optional<ClockReport> clock;
+  PointTimesReport point_times_base, point_times_target;
 
   bool ok() const { return success; }
 };

@@ -64,6 +64,7 @@
 #include "pipeline/pair_calibration.hpp"
 #include "pipeline/stages.hpp"
 #include "pipeline/terra_stage.hpp"
+#include "pipeline/vouch.hpp"
 #include "ulc/core/frame_range.hpp"
 #include "ulc/core/types.hpp"
 
@@ -246,10 +247,14 @@ PairCalibration run_pipeline(const FA& frames_a, const std::vector<double>& time
                                  has_stage(options.stages, Stage::terra),
                                  has_stage(options.stages, Stage::jeep),
                                  has_stage(options.stages, Stage::hots)};
+  r.point_times_base = point_times_of(in.a.frames);
+  r.point_times_target = point_times_of(in.b.frames);
   if (!in.run_terra) {
     r.T_base_target = *options.initial;
     const StageOutcome o = run_attempt(in, *options.initial, "", true, r);
-    return finish(o.status, o.reason);
+    finish(o.status, o.reason);
+    const StageOutcome v = vouch(in, r);
+    return finish(v.status, v.reason);
   }
   const auto starts = terra_step(frames_a, times_a, frames_b, times_b, options, r);
   if (!starts)
@@ -257,7 +262,9 @@ PairCalibration run_pipeline(const FA& frames_a, const std::vector<double>& time
                   std::string("TERRA: ") + terra::to_string(r.terra->status) + ": " +
                       r.terra->reason + " (on " + to_string(r.terra->source) + ")");
   if (!in.run_jeep && !in.run_hots) return terra_only(*starts, r, finish);
-  return try_hypotheses(in, *starts, r, finish);
+  try_hypotheses(in, *starts, r, finish);
+  const StageOutcome v = vouch(in, r);
+  return finish(v.status, v.reason);
 }
 
 }  // namespace calibrate_detail

@@ -25,6 +25,8 @@
 //     base -> i -> j -> base is E = T_base_i * T_i_j * T_base_j^-1 (identity when everything
 //     agrees): rotation_deg = angle of E, translation_m = |translation of E|. Without terra in
 //     cycle_stages, the guess is T_base_i^-1 * T_base_j (so the cycle only tests refinement).
+//     When both targets' clock offsets are known (given, or estimated by HOTS), the i -> j
+//     calibration is given their difference, so it need not estimate one (pipeline/vouch.hpp).
 //     A pair where one target was routed through the other is skipped: that cycle is the route
 //     itself and closes by construction, which would look like evidence and is none.
 //     At most options.max_cycles cycles, the first ones in that order.
@@ -253,6 +255,12 @@ RigCycle close_cycle(const std::vector<RigLidar<Frames>>& lidars, const RigTarge
   CalibrateOptions o = pair_options(options.pair, "cycle " + ti.name + "-" + tj.name + " ",
                                     ti.result.T_base_target.inverse() * tj.result.T_base_target);
   o.stages = options.cycle_stages;
+  // Both clocks known against the base (given or estimated by HOTS): t_i = t_j + (o_j - o_i).
+  auto known = [](const PairCalibration& p) {
+    return p.clock && p.clock->source != ClockSource::not_estimated;
+  };
+  if (known(ti.result) && known(tj.result))
+    o.time_offset_s = tj.result.time_offset_s - ti.result.time_offset_s;
   RigCycle c;
   c.i = ti.lidar;
   c.j = tj.lidar;

@@ -125,8 +125,9 @@ TEST_CASE("ulc calibrate --stages terra writes the result file of docs/design.md
 TEST_CASE("ulc calibrate terra,jeep passes ulc evaluate", "[app][calibrate]") {
   const Dataset d("ulc_test_calibrate_full");
   const std::string out = d.file("result.json");
-  const auto run = run_command(kUlc + " calibrate" + d.pair_args() +
-                               " --stages terra,jeep --threads 2 --output " + quote(out));
+  const auto run =
+      run_command(kUlc + " calibrate" + d.pair_args() +
+                  " --synced-clocks --stages terra,jeep --threads 2 --output " + quote(out));
   INFO(run.output);
   REQUIRE(run.exit_code == 0);
   const auto r = ulc::io::read_result_file(out);
@@ -148,8 +149,8 @@ TEST_CASE("ulc calibrate --stages jeep takes --initial as numbers or a result fi
   guess.translation() += Eigen::Vector3d(0.3, -0.3, 0.25);
   const std::string numbers = d.file("from_numbers.json");
   const auto run = run_command(kUlc + " calibrate --quiet" + d.pair_args() +
-                               " --stages jeep --frames 4 --initial " + quote(xyz_rpy(guess)) +
-                               " --output " + quote(numbers));
+                               " --synced-clocks --stages jeep --frames 4 --initial " +
+                               quote(xyz_rpy(guess)) + " --output " + quote(numbers));
   INFO(run.output);
   REQUIRE(run.exit_code == 0);
   const auto r = ulc::io::read_result_file(numbers);
@@ -171,7 +172,7 @@ TEST_CASE("ulc calibrate --stages jeep takes --initial as numbers or a result fi
   ulc::io::write_result_file(d.file("seed.json"), {seed});
   const std::string from_file = d.file("from_file.json");
   const auto again = run_command(kUlc + " calibrate --quiet" + d.pair_args() +
-                                 " --stages jeep --frames 4 --initial " +
+                                 " --synced-clocks --stages jeep --frames 4 --initial " +
                                  quote(d.file("seed.json")) + " --output " + quote(from_file));
   INFO(again.output);
   REQUIRE(again.exit_code == 0);
@@ -190,9 +191,9 @@ TEST_CASE("ulc calibrate --format yaml, --merged-cloud and --report write what t
   const std::string yaml = d.file("result.yaml"), fused = d.file("fused.pcd"),
                     report = d.file("report.png");
   const auto run = run_command(kUlc + " calibrate --quiet" + d.pair_args() +
-                               " --stages jeep --frames 4 --initial " + quote(xyz_rpy(guess)) +
-                               " --format yaml --output " + quote(yaml) + " --merged-cloud " +
-                               quote(fused) + " --report " + quote(report));
+                               " --synced-clocks --stages jeep --frames 4 --initial " +
+                               quote(xyz_rpy(guess)) + " --format yaml --output " + quote(yaml) +
+                               " --merged-cloud " + quote(fused) + " --report " + quote(report));
   INFO(run.output);
   REQUIRE(run.exit_code == 0);
 
@@ -403,4 +404,45 @@ TEST_CASE(
     CHECK(e.rotation_deg < 1.0);
     CHECK(e.translation_m < 0.10);
   }
+}
+
+TEST_CASE("ulc calibrate names a LiDAR without point times and says the offset was not estimated",
+          "[app][calibrate][vouch]") {
+  const Dataset d("ulc_test_calibrate_untimed");
+  // The VLP-32C's frames written again without their per-point times.
+  const auto strip = run_command(kUlc + " simulate --quiet --scenario 64-32 --seconds 0.6 " +
+                                 "--seed 2 --no-point-times lidar32 --out " + quote(d.file("")));
+  INFO(strip.output);
+  REQUIRE(strip.exit_code == 0);
+  const std::string out = d.file("result.json");
+  const auto run = run_command(kUlc + " calibrate --quiet" + d.pair_args() +
+                               " --synced-clocks --stages terra,jeep --output " + quote(out));
+  INFO(run.output);
+  REQUIRE(run.exit_code == 0);
+  CHECK_THAT(run.output, Catch::Contains("times   lidar32 (synthesised_from_azimuth)"));
+  const auto r = ulc::io::read_result_file(out);
+  REQUIRE(r.size() == 1);
+  CHECK(r[0].point_times.at("base").at("source").get<std::string>() == "per_point");
+  CHECK(r[0].point_times.at("target").at("source").get<std::string>() ==
+        "synthesised_from_azimuth");
+  CHECK(r[0].point_times.at("target").at("frames_without").get<double>() == 6);
+  CHECK(r[0].clock.at("source").get<std::string>() == "given");
+  CHECK(evaluate_success(d, out));
+
+  // No offset given: moving, six frames cannot bound a lag, and the result says so.
+  const auto unsynced = run_command(kUlc + " calibrate --quiet" + d.pair_args() +
+                                    " --stages terra,jeep --output " + quote(out));
+  INFO(unsynced.output);
+  CHECK(unsynced.exit_code == 1);
+  CHECK_THAT(unsynced.output, Catch::Contains("time_offset_unestimated"));
+  const auto refused = ulc::io::read_result_file(out);
+  REQUIRE(refused.size() == 1);
+  CHECK_FALSE(refused[0].success);
+  CHECK(refused[0].clock.at("source").get<std::string>() == "not_estimated");
+  CHECK_THAT(refused[0].reason, Catch::Contains("the clock offset was not estimated"));
+
+  const auto unknown = run_command(kUlc + " simulate --quiet --scenario 64-32 --seconds 0.3 " +
+                                   "--no-point-times lidar99 --out " + quote(d.file("x")));
+  CHECK(unknown.exit_code == 2);
+  CHECK_THAT(unknown.output, Catch::Contains("no LiDAR named 'lidar99'"));
 }

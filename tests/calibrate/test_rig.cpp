@@ -51,6 +51,7 @@ std::vector<ulc::RigLidar<Frames>> views(const ulc::sim::Dataset& d,
 ulc::RigOptions terra_jeep() {
   ulc::RigOptions o;
   o.pair.stages = {Stage::terra, Stage::jeep};
+  o.pair.time_offset_s = 0.0;  // the simulator's clocks are synchronised
   return o;
 }
 

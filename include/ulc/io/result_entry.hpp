@@ -12,7 +12,9 @@
 // -fno-exceptions promise.
 #pragma once
 
+#include <cmath>
 #include <string>
+#include <utility>
 
 #include "pipeline/pair_calibration.hpp"
 #include "ulc/core/lie.hpp"
@@ -123,6 +125,7 @@ inline Json jeep_to_json(const JeepReport& r) {
   j["start_chosen"] = r.start_chosen;
   j["judged_by_hots"] = r.judged_by_hots;
   j["seconds"] = r.seconds;
+  j["target_speed_mps"] = r.target_speed_mps;
   return j;
 }
 
@@ -202,6 +205,40 @@ inline Json hots_to_json(const HotsReport& h) {
   return j;
 }
 
+/// "clock": where the offset came from and, when nobody estimated it, its effect and the lag
+/// the motions show (pipeline/vouch.hpp).
+inline Json clock_to_json(const ClockReport& c) {
+  Json j = Json::object();
+  j["source"] = to_string(c.source);
+  j["note"] = c.note;
+  if (c.source != ClockSource::not_estimated) return j;
+  j["verdict"] = c.verdict;
+  j["speed_mps"] = c.speed_mps;
+  j["translation_per_ms_m"] = c.translation_per_ms_m;
+  j["lag_checked"] = c.lag_checked;
+  if (c.lag_checked) {
+    j["lag_s"] = c.lag_s;
+    j["lag_sigma_s"] = std::isfinite(c.lag_sigma_s) ? Json(c.lag_sigma_s) : Json();
+    j["lag_samples"] = c.lag_samples;
+    j["lag_window_s"] = c.lag_window_s;
+  }
+  return j;
+}
+
+/// "point_times": each LiDAR's source of per-point times and what was done without them.
+inline Json point_times_to_json(const PointTimesReport& base, const PointTimesReport& target) {
+  Json j = Json::object();
+  for (const auto& [key, p] :
+       {std::pair<const char*, const PointTimesReport*>{"base", &base}, {"target", &target}}) {
+    Json e = Json::object();
+    e["source"] = to_string(p->source);
+    e["frames_without"] = p->frames_without;
+    e["note"] = p->note;
+    j[key] = std::move(e);
+  }
+  return j;
+}
+
 /// The result-file entry for target `target` against base `base`.
 inline PairResult to_pair_result(const PairCalibration& c, const std::string& base,
                                  const std::string& target) {
@@ -214,6 +251,8 @@ inline PairResult to_pair_result(const PairCalibration& c, const std::string& ba
   r.T_base_target = c.T_base_target;
   r.time_offset_s = c.time_offset_s;
   if (c.covariance_6x6) r.covariance_6x6 = *c.covariance_6x6;
+  if (c.clock) r.clock = clock_to_json(*c.clock);
+  r.point_times = point_times_to_json(c.point_times_base, c.point_times_target);
   r.stages = Json::object();
   if (c.terra) r.stages["terra"] = terra_to_json(*c.terra);
   if (c.jeep) r.stages["jeep"] = jeep_to_json(*c.jeep);

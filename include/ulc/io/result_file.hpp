@@ -39,6 +39,11 @@ struct PairResult {
   std::string via;                 ///< the LiDAR it was calibrated through; empty: direct
   std::string direct_status;       ///< when routed: the direct attempt's status word
   std::string direct_reason;       ///< when routed: why the direct attempt failed
+  /// What the data cannot vouch for (pipeline/vouch.hpp): "clock" {source, note, speed, lag,
+  /// ...} when a translation was estimated, "point_times" {"base": {...}, "target": {...}}.
+  /// Null: not written.
+  Json clock;
+  Json point_times;
 };
 
 /// The cycle base -> i -> j -> base: how far T_base_i * T_i_j * T_base_j^-1 is from identity.
@@ -71,6 +76,8 @@ inline Json to_json(const PairResult& r) {
   e["rpy_deg"] = vector_to_json(ulc::rpy_from_rotation(r.T_base_target.linear()) * kDeg);
   e["time_offset_s"] = r.time_offset_s ? Json(*r.time_offset_s) : Json();
   e["covariance_6x6"] = r.covariance_6x6 ? matrix_to_json(*r.covariance_6x6) : Json();
+  if (!r.clock.is_null()) e["clock"] = r.clock;
+  if (!r.point_times.is_null()) e["point_times"] = r.point_times;
   e["stages"] = r.stages;
   e["timing_s"] = r.timing_s;
   if (!r.via.empty()) {
@@ -141,6 +148,8 @@ inline std::vector<PairResult> results_from_json(const Json& doc, const std::str
       r.covariance_6x6 = json_to_matrix<6, 6>(*c, file, where + ".covariance_6x6");
     if (const Json* s = find_member(e, "stages"); s && s->is_object()) r.stages = *s;
     if (const Json* s = find_member(e, "timing_s"); s && s->is_object()) r.timing_s = *s;
+    if (const Json* c = find_member(e, "clock"); c && c->is_object()) r.clock = *c;
+    if (const Json* p = find_member(e, "point_times"); p && p->is_object()) r.point_times = *p;
     if (const Json* v = find_member(e, "via"); v && v->is_string()) r.via = v->get<std::string>();
     if (const Json* d = find_member(e, "direct"); d && d->is_object()) {
       if (const Json* s = find_member(*d, "status"); s && s->is_string())

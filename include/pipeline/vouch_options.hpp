@@ -1,0 +1,35 @@
+// The options of the checks on what the data cannot vouch for (pipeline/vouch.hpp): a clock
+// offset nobody estimated, and frames without per-point times. Light: no algorithm.
+#pragma once
+
+#include <cstddef>
+
+namespace ulc {
+
+struct VouchOptions {
+  /// How far an unestimated clock offset, or a sweep that could not be deskewed, may move the
+  /// translation before the result stops being a success (m). Half the 10 cm of a success
+  /// (the paper's threshold) leaves the rest to the registration itself; the benchmark
+  /// bench_clocks measures both sides (docs/experiments/unestimated_clocks.md).
+  double max_translation_effect_m = 0.05;
+  /// The lag between the two LiDARs' motions is searched within +- this (s); an offset of this
+  /// size is also what "any plausible offset" means for a slow rig.
+  double max_lag_s = 0.25;
+  double lag_step_s = 0.001;  ///< grid of the lag search before its parabola refinement (s)
+  /// The motions compared: rotation rates and velocities over this baseline (s), normalised by
+  /// noise levels no smaller than these floors (motion_lag.hpp).
+  /// The rate floor is high on purpose: a straight drive's rates are its bumps' pitch and roll,
+  /// which the two LiDARs' frames alias differently; only turns (0.1-0.5 rad/s) should count.
+  double lag_baseline_s = 0.6;
+  double rate_noise = 0.03;      ///< rad/s
+  double velocity_noise = 0.03;  ///< m/s
+  /// Seconds of each LiDAR's frames (from frame_index) whose single-LiDAR odometries give the
+  /// rotation rates the lag is estimated from: long enough to hold a turn.
+  double lag_window_s = 30.0;
+  /// The lag counts as bounded when (|lag| + sigma_factor * sigma) * speed is within
+  /// max_translation_effect_m.
+  double sigma_factor = 3.0;
+  bool enabled = true;  ///< false: no check (the result still says the offset was not estimated)
+};
+
+}  // namespace ulc
