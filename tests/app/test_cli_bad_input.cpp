@@ -5,9 +5,9 @@
 // Ctrl-C stops the command with exit code 130 and leaves no file behind.
 #include <algorithm>
 #include <catch2/catch.hpp>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <cmath>
 #include <fstream>
 #include <limits>
 #include <string>
@@ -169,6 +169,12 @@ TEST_CASE("bad input: a folder with no frames, an empty file", "[app][bad_input]
     write_bytes(d / name, {});
     check_refused(d.calibrate(d / name, "--stages terra"), {name, ": empty file"});
   }
+  // An empty KITTI .bin is a valid cloud of no points: nothing to calibrate, and the result says
+  // so.
+  write_bytes(d / "empty.bin", {});
+  const fs::path result = d / "result.json";
+  check_failed(d.calibrate(d / "empty.bin", "--stages terra --output " + quote(result.string())),
+               result, "target cloud is empty");
 }
 
 TEST_CASE("bad input: timestamps.txt whose times go back or repeat is refused at the line",
@@ -264,7 +270,8 @@ TEST_CASE("bad input: pcl_ros sec.nsec names are read as times and order the fra
   CHECK_THAT(inspect_line(d / "lidar32", 0, "frame time:"),
              Catch::StartsWith("frame time:  " + format("%.6f", 1645000000.0523 + seconds[0])));
   const fs::path result = d / "result.json";
-  const auto run = d.calibrate(d / "lidar32", "--stages terra,jeep --output " + quote(result.string()));
+  const auto run =
+      d.calibrate(d / "lidar32", "--stages terra,jeep --output " + quote(result.string()));
   INFO(run.output);
   CHECK(run.exit_code == 0);
   CHECK(evaluate_success(d, result));
@@ -307,8 +314,10 @@ TEST_CASE("bad input: truncated and corrupted binary frames, a header claiming 2
   // Headers claiming 2^40 points, refused before any allocation (run under a 2 GiB address
   // space limit: an attempt to allocate for them would fail as out of memory, exit code 1).
   const std::string huge = "1099511627776";
-  const std::string header = "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n"
-                             "WIDTH " + huge + "\nHEIGHT 1\nPOINTS " + huge + "\n";
+  const std::string header =
+      "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n"
+      "WIDTH " +
+      huge + "\nHEIGHT 1\nPOINTS " + huge + "\n";
   for (const std::string kind : {"binary", "binary_compressed", "ascii"}) {
     const fs::path file = d / ("huge_" + kind + ".pcd");
     std::string text = header + "DATA " + kind + "\n";
@@ -333,11 +342,11 @@ TEST_CASE("Ctrl-C stops ulc calibrate with exit code 130 and leaves no file behi
   const fs::path out = d / "out";
   fs::create_directories(out);
   // SIGINT 2 s into a calibration of every stage over 40 frames, which takes far longer.
-  const auto run = run_command(
-      "timeout --preserve-status -s INT 2 " + kUlc + " calibrate --quiet" + d.base() +
-      " --target " + quote((d / "lidar32").string()) + " --output " +
-      quote((out / "result.json").string()) + " --merged-cloud " +
-      quote((out / "merged.pcd").string()) + " --report " + quote((out / "report.png").string()));
+  const auto run = run_command("timeout --preserve-status -s INT 2 " + kUlc + " calibrate --quiet" +
+                               d.base() + " --target " + quote((d / "lidar32").string()) +
+                               " --output " + quote((out / "result.json").string()) +
+                               " --merged-cloud " + quote((out / "merged.pcd").string()) +
+                               " --report " + quote((out / "report.png").string()));
   INFO(run.output);
   CHECK(run.exit_code == 130);
   CHECK_THAT(run.output, Catch::Contains("ulc calibrate: interrupted (SIGINT)"));
@@ -377,7 +386,8 @@ TEST_CASE("bad input: clouds with nothing to calibrate on fail with the reason i
     const fs::path folder = d / c.name;
     fs::create_directories(folder);
     fs::copy_file(d / "lidar32" / "timestamps.txt", folder / "timestamps.txt");
-    for (int k = 0; k < 6; ++k) fs::copy_file(file, folder / ("00000" + std::to_string(k) + ".pcd"));
+    for (int k = 0; k < 6; ++k)
+      fs::copy_file(file, folder / ("00000" + std::to_string(k) + ".pcd"));
     check_failed(d.calibrate(folder, "--stages jeep,hots --initial '0 0 0 0 0 0' --output " +
                                          quote(result.string())),
                  result, c.jeep_reason);
@@ -426,9 +436,8 @@ TEST_CASE("bad input: LiDARs with 60 and 3 frames calibrate, HOTS skipped and sa
     const std::string target =
         short_one == std::string("lidar32") ? few.string() + "=lidar32" : (d / "lidar32").string();
     const fs::path result = d / "result.json";
-    const auto run = run_command(kUlc + " calibrate --quiet --base " + quote(base) +
-                                 " --target " + quote(target) + " --output " +
-                                 quote(result.string()));
+    const auto run = run_command(kUlc + " calibrate --quiet --base " + quote(base) + " --target " +
+                                 quote(target) + " --output " + quote(result.string()));
     INFO(run.output);
     CHECK(run.exit_code == 0);
     CHECK(evaluate_success(d, result));
@@ -438,4 +447,20 @@ TEST_CASE("bad input: LiDARs with 60 and 3 frames calibrate, HOTS skipped and sa
     CHECK_THAT(r[0].stages.at("hots").at("reason").get<std::string>(),
                Catch::Contains("only 3 frame(s)"));
   }
+}
+
+TEST_CASE("Ctrl-C stops ulc simulate with exit code 130 and no temporary left",
+          "[app][interrupt]") {
+  const fs::path out = fs::temp_directory_path() / "ulc_test_interrupt_simulate";
+  fs::remove_all(out);
+  // SIGINT 1 s into a 60 s drive, which takes far longer to write.
+  const auto run =
+      run_command("timeout --preserve-status -s INT 1 " + kUlc +
+                  " simulate --quiet --scenario 64-32 --seconds 60 --out " + quote(out.string()));
+  INFO(run.output);
+  CHECK(run.exit_code == 130);
+  CHECK_THAT(run.output, Catch::Contains("ulc simulate: interrupted (SIGINT)"));
+  if (fs::exists(out)) CHECK(temporaries_in(out) == 0);
+  CHECK_FALSE(fs::exists(out / "ground_truth.json"));  // written last, never reached
+  fs::remove_all(out);
 }
