@@ -249,8 +249,8 @@ class Sequence {
                     "has " + std::to_string(times.size()) + " frame times but the folder has " +
                         std::to_string(frames_.size()) + " frames");
     detail::require_increasing_lines(times, stamps);
-    to_seconds(times, stamps.string(), "frame times");
-    for (std::size_t i = 0; i < frames_.size(); ++i) frames_[i].timestamp = times[i];
+    const double unit = seconds_per_unit(times, stamps.string(), "frame times");
+    for (std::size_t i = 0; i < frames_.size(); ++i) frames_[i].timestamp = times[i] * unit;
     source_ = FrameTimeSource::timestamps_file;
   }
 
@@ -276,13 +276,7 @@ class Sequence {
     for (const FrameInfo& f : frames_) files.push_back(f.path);
     auto times = times_from_file_names(files);
     if (!times) return false;
-    std::vector<double> sorted = *times;
-    std::sort(sorted.begin(), sorted.end());
-    const double unit =
-        frame_time_unit(sorted, path_.string(), "frame times in the file names").seconds;
-    if (unit != 1.0)
-      notes_.push_back(path_.string() + ": frame times in the file names read as " +
-                       frame_time_unit(sorted, "", "").name + " and converted to seconds");
+    const double unit = seconds_per_unit(*times, path_.string(), "frame times in the file names");
     for (std::size_t i = 0; i < frames_.size(); ++i) frames_[i].timestamp = (*times)[i] * unit;
     source_ = FrameTimeSource::file_name;
     order_by_time();
@@ -301,15 +295,18 @@ class Sequence {
           "timestamps.txt if that is wrong");
   }
 
-  /// Converts frame times in ms, us or ns to seconds (frame_times.hpp) and says so.
-  void to_seconds(std::vector<double>& times, const std::string& file, const std::string& what) {
+  /// Seconds per unit of `times` (frame_times.hpp), noted when the unit is not seconds.
+  double seconds_per_unit(std::vector<double> times, const std::string& file,
+                          const std::string& what) {
+    std::sort(times.begin(), times.end());
     const TimeUnit unit = frame_time_unit(times, file, what);
-    if (unit.seconds == 1.0) return;
-    for (double& t : times) t *= unit.seconds;
-    notes_.push_back(file + ": " + what + " read as " + unit.name + " and converted to seconds");
+    if (unit.seconds != 1.0)
+      notes_.push_back(file + ": " + what + " read as " + unit.name + " and converted to seconds");
+    return unit.seconds;
   }
 
-  /// Sorts the frames by time and refuses two frames with the same time.
+  /// Sorts the frames by time; refuses two frames with the same time, and frames whose median
+  /// period is no LiDAR's (under 2 ms) nor a slow capture's (up to 1000 s).
   void order_by_time() {
     std::stable_sort(frames_.begin(), frames_.end(), [](const FrameInfo& a, const FrameInfo& b) {
       return a.timestamp < b.timestamp;
@@ -322,7 +319,7 @@ class Sequence {
     std::vector<double> times;
     for (const FrameInfo& f : frames_) times.push_back(f.timestamp);
     const double step = median_step(times);
-    if (frames_.size() > 1 && !(step > kMinFramePeriod && step <= kMaxFramePeriod * 1e3))
+    if (frames_.size() > 1 && !(step > kMinFramePeriod && step <= kMaxSavedFramePeriod))
       throw IoError(
           path_.string(), "",
           "frame times " +
