@@ -37,9 +37,13 @@
 //   - Result extrinsic and offset = the whole-sequence step's (sequence_extrinsic.hpp),
 //     started from the time synchronisation's mean (eq:mean) and offset (without
 //     synchronisation: the graph's C and time_offset_s); with that step disabled, its start.
-//     statistics keep the graph's and the synchronisation's answers. covariance_6x6 = the spread of
-//     the per-pair extrinsics ([rho; phi], left); without synchronisation, the graph's marginal
-//     covariance of C.
+//     statistics keep the graph's and the synchronisation's answers. covariance_6x6 ([rho; phi],
+//     left, base frame; m, rad) = the whole-sequence step's sandwich covariance of C
+//     (sequence_extrinsic.hpp) plus delta delta^T, delta = log(C_start C^-1) the step's move from
+//     the graph's or the synchronisation's C: two models of the same data, whose disagreement is
+//     the one sample the result has of an error every frame shares (refine_steps.hpp,
+//     sequence_step). With that step disabled or singular: the spread of the per-pair
+//     extrinsics, or without synchronisation the graph's marginal covariance of C.
 //   - refined poses are returned in the input map frames (b's through T_mapa_mapb).
 //   - With time synchronisation on, the whole-sequence step checks that the drive pins the
 //     clock offset down (sequence_extrinsic.hpp, check_time_offset); when it does not, the

@@ -55,6 +55,10 @@ struct SequenceExtrinsicResult {
   double rmse = 0.0;   ///< m, inliers at the result
   double cost = 0.0;   ///< final robust cost at the result
   int iterations = 0;  ///< matchings, all solves and stages
+  /// Covariance of C ([rho; phi], left, base frame; m and rad) from the final problem
+  /// (sequence_extrinsic.hpp, extrinsic_covariance); zero when none could be formed.
+  Mat6d covariance_6x6 = Mat6d::Zero();
+  bool has_covariance = false;
 
   bool ok() const { return status == SequenceExtrinsicStatus::ok; }
 };

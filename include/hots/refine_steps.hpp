@@ -451,8 +451,17 @@ bool sequence_step(RefineState<S>& s, const RefineOptions& options, RefineResult
     result.reason = st.sequence.reason;
     return false;
   }
+  const Isometry3d start = result.extrinsic;
   result.extrinsic = st.sequence.extrinsic;
   result.time_offset_s = st.sequence.time_offset_s;
+  if (st.sequence.has_covariance) {
+    // The sandwich sees errors that differ between frames; an error every frame shares (a
+    // trajectory bias, a modelling error of the whole scene) is invisible to it. The step's
+    // move from the graph's (or synchronisation's) C, a second model of the same data, is one
+    // sample of that disagreement: added as a rank-one term (hots.hpp).
+    const Vec6d moved = ulc::se3_log(Isometry3d(start * result.extrinsic.inverse()));
+    result.covariance_6x6 = st.sequence.covariance_6x6 + moved * moved.transpose();
+  }
   return true;
 }
 

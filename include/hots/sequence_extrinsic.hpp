@@ -43,6 +43,16 @@
 //     tens of milliseconds off with a sigma of 0.1 ms
 //     (docs/experiments/time_offset_drive_length.md). A distrusted
 //     offset is reported (time_offset_trusted, time_offset_doubt); it does not change C or dt.
+//   - Extrinsic covariance (covariance_6x6, [rho; phi] of C <- exp(xi) C: base frame, m and rad)
+//     from the final problem at the answer, by the M-estimator sandwich A^-1 M A^-1
+//     (ulc/core/cluster_covariance.hpp): A = sum psi'(r) J J^T, the robust cost's curvature
+//     (kernel.curvature: the Geman-McClure kernel of the fine stage turns residuals beyond
+//     scale / sqrt(3) away, so A is several times smaller than the IRLS normal matrix sum w J J^T,
+//     whose inverse is 3-10x too small in sigma on the simulated drives), and M the outer products
+//     of the gradients sum w r J of each target frame (one frame's points share its placement
+//     error: per-point clustering is another 2-4x too small). With dt solved alongside C it is
+//     the 7x7 sandwich's 6x6 block, so dt's uncertainty widens C's.
+//     Measured in docs/experiments/covariance_coverage.md.
 //   - The result keeps C and dt of the input when the registration fails (status says why).
 //   - Nothing here throws or prints; the same results for any number of threads (per-term
 //     deterministic reductions summed in term order).
@@ -51,7 +61,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <limits>
+#include <optional>
 #include <tuple>
 #include <utility>
 #include <vector>
@@ -67,6 +79,7 @@
 #include "hots/options.hpp"
 #include "hots/refine_statistics.hpp"
 #include "hots/time_sync.hpp"
+#include "ulc/core/cluster_covariance.hpp"
 #include "ulc/core/gauss_newton.hpp"
 #include "ulc/core/point_to_plane.hpp"
 #include "ulc/core/registration_target.hpp"
@@ -294,6 +307,24 @@ class SequenceProblem {
   JointSums final_sums(const State& x) {
     match(x);
     return sums(x.C);
+  }
+
+  /// Every matched point of the current matches at C: visit(frame k of `used`, J, r) in term
+  /// and point order.
+  template <class Visit>
+  void visit_points(const Isometry3d& C, Visit&& visit) const {
+    Vec7 J;
+    for (std::size_t i = 0; i < terms_.size(); ++i) {
+      const Term& term = terms_[i];
+      if (matches_[i].size() != term.size) continue;
+      for (std::size_t p = 0; p < term.size; ++p) {
+        const ulc::PlaneMatch& plane = matches_[i][p];
+        if (plane.normal.squaredNorm() == 0.0) continue;
+        const double r = joint_residual(term.points[p].template cast<double>(), C, term.post,
+                                        dposts_[i], plane, J);
+        visit(term_frame_[i], J, r);
+      }
+    }
   }
 
  private:
@@ -526,6 +557,34 @@ void check_offset(SequenceProblem<S>& problem, const Solve& s, double dt0,
   result.time_offset_trusted = *result.time_offset_doubt == '\0';
 }
 
+/// The covariance of C from the final problem at the solve's answer (see extrinsic covariance
+/// in the header comment): the M-estimator sandwich A^-1 M A^-1 with A = sum psi'(r) J J^T and
+/// the gradients w r J clustered by target frame. With dt solved alongside C (7 parameters) it
+/// is the 7x7 sandwich's 6x6 block (C's marginal); with dt held, the 6x6 problem's. Empty when
+/// A is singular or fewer than two frames matched.
+template <typename S>
+std::optional<Mat6d> extrinsic_covariance(SequenceProblem<S>& problem, const Solve& s,
+                                          bool with_time, const SequenceExtrinsicOptions& o) {
+  const ulc::RegistrationOptions& stage = o.stages.back();
+  problem.set_stage(stage, with_time);
+  problem.match({s.C, s.dt});
+  Mat7 A = Mat7::Zero();
+  ulc::ClusterGradients<7, std::size_t> frames;
+  problem.visit_points(s.C, [&](std::size_t frame, const Vec7& J, double r) {
+    A.noalias() += stage.kernel.curvature(r) * J * J.transpose();
+    frames.add(frame, Vec7((stage.kernel.weight(r) * r) * J));
+  });
+  if (frames.clusters() < 2) return std::nullopt;
+  const Mat7 M = frames.meat();
+  if (with_time) {
+    const auto c = ulc::sandwich_covariance<7>(A, M);
+    if (!c) return std::nullopt;
+    return Mat6d(c->topLeftCorner<6, 6>());
+  }
+  return ulc::sandwich_covariance<6>(Mat6d(A.topLeftCorner<6, 6>()),
+                                     Mat6d(M.topLeftCorner<6, 6>()));
+}
+
 /// The solve's answer and statistics into the result.
 template <typename S>
 void take_solve(const Solve& s, const SequenceProblem<S>& problem,
@@ -582,6 +641,10 @@ SequenceExtrinsicResult sequence_extrinsic(const HierarchyResult<S>& ha,
     if (!s.ok) return fail(SequenceExtrinsicStatus::registration_failed, s.reason);
   }
   d::take_solve(s, problem, result);
+  if (const auto c = d::extrinsic_covariance(problem, s, joint && result.time_offset_refined, o)) {
+    result.covariance_6x6 = *c;
+    result.has_covariance = true;
+  }
   return result;
 }
 

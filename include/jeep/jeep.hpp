@@ -19,6 +19,13 @@
 //     pose of a by less than the same. No settling within max_rounds (the paper: "exceeding a
 //     certain number of iterations is a failure"; 10) gives status not_converged.
 //   - Acceptance (status rejected otherwise), see acceptance.hpp.
+//   - covariance_6x6: of the final C ([rho; phi], left: C <- exp(xi) C, base frame, m and rad)
+//     from the last round's calibration problem at that C: map b at the last stage's source
+//     voxel against map a's planes, the cluster-robust sandwich with the points in one
+//     covariance_cell-sized cell of map a as a cluster (ulc/core/registration_covariance.hpp:
+//     the robust kernel's curvature as the bread), plus delta delta^T with delta the two-way
+//     step's move from the forward registration's answer (two models of the same maps; one
+//     sample of an error all cells share). Empty when it cannot be formed (a singular problem).
 //   - Nothing here throws or prints; the result is the same for any number of threads.
 #pragma once
 
@@ -41,6 +48,7 @@
 #include "odometry/scan_preparation.hpp"
 #include "ulc/core/lie.hpp"
 #include "ulc/core/point_traits.hpp"
+#include "ulc/core/registration_covariance.hpp"
 #include "ulc/core/types.hpp"
 
 namespace jeep {
@@ -71,6 +79,7 @@ struct JeepResult {
   StartSearchReport start_search;          ///< the first calibration phase's start search
   AcceptanceReport acceptance;             ///< accepted: by acceptance.hpp's rule
   TwoWayResult two_way;  ///< the last step when JeepOptions::two_way (applied: it was used)
+  std::optional<ulc::Mat6d> covariance_6x6;  ///< of extrinsic (see the header comment)
   std::vector<JeepRound> trace;
   /// The last round's maps (eq:build_map) at calibration.target_voxel, in the frames of
   /// poses_a and poses_b: where they overlap, map_a = C * map_b.
@@ -95,7 +104,8 @@ const char* input_problem(const FramesA& frames_a, const std::vector<double>& ti
                           const Isometry3d& initial, const JeepOptions& options) {
   if (options.frames < 1 || options.max_rounds < 1 ||
       !odometry::valid_odometry_options(options.odometry) || options.calibration.stages.empty() ||
-      options.refine_stages < 1 || !(options.default_period > 0.0))
+      options.refine_stages < 1 || !(options.default_period > 0.0) ||
+      !(options.covariance_cell >= 0.0))
     return "bad options";
   if (frames_a.size() != times_a.size() || frames_b.size() != times_b.size())
     return "frame and timestamp counts differ";
@@ -269,6 +279,16 @@ void judge_last_round(const PosePhase<S>& phase, const CalibrationPhase<S>& cal,
                       const Isometry3d& C, const JeepOptions& options, JeepResult& result) {
   result.acceptance =
       assess(cal.map_a, cal.map_b, cal.target, options.calibration, C, options.acceptance);
+  const MapStage& last = cal.stages.stages.back();
+  result.covariance_6x6 =
+      ulc::point_to_plane_covariance(downsampled(cal.map_b, last.source_voxel).points, cal.target,
+                                     C, last.registration, options.covariance_cell);
+  if (result.covariance_6x6) {
+    // The two-way step's move from the forward registration's answer: a sample of the
+    // disagreement between two models of the same data (see the header comment).
+    const Vec6d moved = ulc::se3_log(Isometry3d(cal.registration.pose * C.inverse()));
+    *result.covariance_6x6 += moved * moved.transpose();
+  }
   const Isometry3d to_first = phase.poses_a[0].inverse();
   const Isometry3d to_first_b = C.inverse() * to_first * C;
   for (const auto& p : downsampled(cal.map_a, options.calibration.target_voxel).points)

@@ -114,6 +114,9 @@ struct JeepOptions {
   /// Once settled, meet map a registered to map b's planes halfway (two_way.hpp), so that
   /// swapping base and target gives the inverse extrinsic.
   bool two_way = true;
+  /// Side of the cells whose points share their errors in the covariance of C (m; 0: every
+  /// point independent). See jeep.hpp, covariance_6x6.
+  double covariance_cell = 3.0;
 };
 
 }  // namespace jeep

@@ -151,7 +151,10 @@ std::optional<StageOutcome> jeep_step(const AttemptInputs<FA, FB>& in, Attempt& 
       return StageOutcome{CalibrateStatus::jeep_failed, at.jeep_failure, true};
   }
   at.extrinsic = j.extrinsic;
-  if (j.ok()) at.out.T_base_target = at.extrinsic;
+  if (j.ok()) {
+    at.out.T_base_target = at.extrinsic;
+    at.out.covariance_6x6 = j.covariance_6x6;
+  }
   return std::nullopt;
 }
 

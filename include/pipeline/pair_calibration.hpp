@@ -244,8 +244,11 @@ struct PairCalibration {
   std::optional<JeepReport> jeep;
   std::optional<HotsReport> hots;
   /// The known offset (CalibrateOptions::time_offset_s) or HOTS's when it succeeded; otherwise
-  /// 0 (clocks assumed synchronised). No covariance without HOTS.
+  /// 0 (clocks assumed synchronised).
   double time_offset_s = 0.0;
+  /// Of T_base_target, from the last stage's final problem (HOTS's, or JEEP's when HOTS did
+  /// not run or skipped itself): xi = [rho; phi] with T_true = exp(xi) T (left, base frame; m,
+  /// rad). docs/pipeline.md, "The covariance".
   std::optional<Mat6d> covariance_6x6;
   StageTimings timing_s;
   // What the data cannot vouch for (vouch.hpp): the clock offset's provenance and effect

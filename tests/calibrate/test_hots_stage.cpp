@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Eigenvalues>
+
 #include "calibrate_test_util.hpp"
 #include "pipeline/calibrate.hpp"
 #include "ulc/core/pose_error.hpp"
@@ -82,6 +84,10 @@ TEST_CASE("terra,jeep,hots recovers the 64-32 mounting with synchronised clocks"
   REQUIRE(c.covariance_6x6);
   CHECK(c.covariance_6x6->allFinite());
   CHECK(c.covariance_6x6->trace() > 0.0);
+  CHECK((*c.covariance_6x6 - c.covariance_6x6->transpose()).cwiseAbs().maxCoeff() <=
+        1e-12 * c.covariance_6x6->cwiseAbs().maxCoeff());
+  CHECK(Eigen::SelfAdjointEigenSolver<ulc::Mat6d>(*c.covariance_6x6).eigenvalues().minCoeff() >
+        0.0);
   CHECK(c.timing_s.odometry > 0.0);
   CHECK(c.timing_s.hots > 0.0);
   CHECK(stages_seen == std::vector<std::string>{"terra", "jeep", "odometry", "hots"});

@@ -68,6 +68,27 @@ struct RobustKernel {
     }
   }
 
+  /// psi'(r) = d(weight(r) r) / dr = rho''(r): the curvature the kernel gives a residual (the
+  /// "bread" of an M-estimator's sandwich covariance; negative where the kernel turns a residual
+  /// away, beyond scale / sqrt(3) for Geman-McClure and beyond scale for Cauchy).
+  double curvature(double r) const {
+    if (!active()) return 1.0;
+    const double k2 = scale * scale;
+    const double r2 = r * r;
+    switch (type) {
+      case RobustKernelType::huber:
+        return std::abs(r) <= scale ? 1.0 : 0.0;
+      case RobustKernelType::cauchy:
+        return k2 * (k2 - r2) / ((k2 + r2) * (k2 + r2));
+      case RobustKernelType::geman_mcclure: {
+        const double q = k2 / (k2 + r2);
+        return q * q * (k2 - 3.0 * r2) / (k2 + r2);
+      }
+      default:
+        return 1.0;
+    }
+  }
+
   /// The kernel's cost rho(r) (r^2 / 2 for least squares).
   double rho(double r) const {
     const double r2 = r * r;

@@ -2,7 +2,7 @@
 //
 // Conventions this header owns:
 //   - time_offset_s is the caller's known offset or HOTS's when it succeeded, otherwise 0
-//     (clocks assumed synchronised); covariance_6x6 is HOTS's, null without it.
+//     (clocks assumed synchronised); covariance_6x6 is the last stage's (HOTS's or JEEP's).
 //   - "stages" holds one object per stage that ran ("terra", "jeep", "hots"); "timing_s" always
 //     holds every stage key of docs/design.md ("terra", "jeep", "odometry", "hots", "total"), 0
 //     for a stage that did not run.
