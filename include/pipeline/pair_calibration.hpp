@@ -26,6 +26,7 @@
 #include "pipeline/map_terra_options.hpp"
 #include "pipeline/stages.hpp"
 #include "terra/search_params.hpp"
+#include "ulc/core/observability_types.hpp"
 #include "ulc/core/registration_types.hpp"
 #include "ulc/core/types.hpp"
 
@@ -37,7 +38,11 @@ enum class CalibrateStatus {
   initial_required,  ///< no terra stage and no initial extrinsic
   terra_failed,      ///< TERRA found no rotation (see terra->status)
   jeep_failed,       ///< JEEP did not converge or its result was rejected (see jeep->status)
-  hots_failed        ///< the odometry before HOTS or HOTS itself failed (see hots->status)
+  hots_failed,       ///< the odometry before HOTS or HOTS itself failed (see hots->status)
+  /// The final problem leaves a direction of the extrinsic free (a straight road, a tunnel):
+  /// `unobservable` names it; the extrinsic's other directions are the data's
+  /// (pipeline/observability_verdict.hpp).
+  degenerate
 };
 
 inline const char* to_string(CalibrateStatus s) {
@@ -52,6 +57,8 @@ inline const char* to_string(CalibrateStatus s) {
       return "terra_failed";
     case CalibrateStatus::jeep_failed:
       return "jeep_failed";
+    case CalibrateStatus::degenerate:
+      return "degenerate";
     default:
       return "hots_failed";
   }
@@ -126,6 +133,10 @@ struct JeepReport {
   /// JEEP failed (rejected or not settled) and HOTS ran from its extrinsic to judge it
   /// (CalibrateOptions::tuning.hypotheses.hots_judges_jeep): the pair's status says which won.
   bool judged_by_hots = false;
+  /// The final map-to-map registration's observability of the extrinsic (the acceptance's
+  /// agreeing points, ulc/core/observability.hpp), when the maps agree (else nothing: the
+  /// information of a misregistration says nothing about the scene).
+  std::optional<Observability> observability;
   double seconds = 0.0;
 };
 
@@ -151,6 +162,9 @@ struct HotsReport {
   Mat6d covariance_6x6 = Mat6d::Zero();           ///< [rho; phi], left
   hots::RefineStatistics statistics;
   std::vector<std::pair<double, double>> spread_curve;  ///< (offset s, spread), last pass
+  /// The whole-sequence step's observability of the extrinsic (ulc/core/observability.hpp),
+  /// when that step ran.
+  std::optional<Observability> observability;
   double odometry_seconds = 0.0;
   double seconds = 0.0;  ///< hots::refine alone
 };
@@ -176,6 +190,13 @@ struct PairCalibration {
   /// 0 (clocks assumed synchronised). No covariance without HOTS.
   double time_offset_s = 0.0;
   std::optional<Mat6d> covariance_6x6;
+  /// Observability of the extrinsic in the final problem (pipeline/observability_verdict.hpp):
+  /// which problem was judged ("hots": the whole-sequence step; "jeep": the final map-to-map
+  /// registration; empty: none), its weakest direction's share, and the directions it leaves
+  /// free (non-empty exactly when status is degenerate).
+  std::string observability_problem;
+  double weakest_share = 0.0;
+  std::vector<UnobservableDirection> unobservable;
   StageTimings timing_s;
 
   bool ok() const { return success; }
