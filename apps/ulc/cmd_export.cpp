@@ -5,7 +5,6 @@
 // at a time.
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <string>
 #include <vector>
 
@@ -34,13 +33,13 @@ std::string frame_file(std::size_t i) {
 }
 
 void write_timestamps(const fs::path& file, const std::vector<double>& times) {
-  std::ofstream out(file);
+  std::string text;
   for (const double t : times) {
     char buf[64];
     std::snprintf(buf, sizeof buf, "%.9f\n", t);
-    out << buf;
+    text += buf;
   }
-  if (!out) throw io::IoError(file.string(), "", "write failed");
+  io::write_file_text(file, text);
 }
 
 std::size_t export_lidar(const LidarInput& input, const fs::path& dir) {

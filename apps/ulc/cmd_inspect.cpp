@@ -79,6 +79,8 @@ std::size_t frame_index(long long index, std::size_t count) {
 
 int inspect_folder(const std::string& path, long long frame_index_arg) {
   const io::Sequence seq(path);
+  for (const std::string& note : seq.notes())
+    std::fprintf(stderr, "ulc inspect: warning: %s\n", note.c_str());
   const std::size_t index = frame_index(frame_index_arg, seq.size());
   std::printf("%s: %zu frame%s, frame times from %s\n", path.c_str(), seq.size(),
               seq.size() == 1 ? "" : "s", time_source_name(seq.time_source()));

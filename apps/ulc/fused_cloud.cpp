@@ -2,10 +2,10 @@
 
 #include <cstdint>
 #include <cstring>
-#include <fstream>
+#include <string>
 
 #include "top_down_image.hpp"
-#include "ulc/io/io_error.hpp"
+#include "ulc/io/file_bytes.hpp"
 
 namespace ulc::app {
 
@@ -26,16 +26,16 @@ void write_fused_cloud(const std::string& pcd, const std::vector<FusedPart>& par
       record.insert(record.end(), {q.x(), q.y(), q.z(), rgb, static_cast<float>(i)});
     }
   }
-  std::ofstream out(pcd, std::ios::binary);
-  if (!out) throw io::IoError(pcd, "", "cannot open for writing");
-  out << "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\nFIELDS x y z rgb lidar\n"
-         "SIZE 4 4 4 4 4\nTYPE F F F F F\nCOUNT 1 1 1 1 1\nWIDTH "
-      << n << "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " << n << "\nDATA binary\n";
+  std::string text =
+      "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\nFIELDS x y z rgb lidar\n"
+      "SIZE 4 4 4 4 4\nTYPE F F F F F\nCOUNT 1 1 1 1 1\nWIDTH " +
+      std::to_string(n) + "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " + std::to_string(n) +
+      "\nDATA binary\n";
   // Little-endian hosts only write this byte order; PCD binary is the host's float layout,
   // which every reader of PCD assumes to be little-endian.
-  out.write(reinterpret_cast<const char*>(record.data()),
-            static_cast<std::streamsize>(record.size() * sizeof(float)));
-  if (!out.flush()) throw io::IoError(pcd, "", "write failed");
+  const auto* bytes = reinterpret_cast<const char*>(record.data());
+  text.append(bytes, record.size() * sizeof(float));
+  io::write_file_text(pcd, text);  // atomic: never half a cloud
 }
 
 }  // namespace ulc::app

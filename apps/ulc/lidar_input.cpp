@@ -73,6 +73,9 @@ class FolderInput : public LidarInput {
     return odometry::frame_period(t);
   }
 
+  /// The rate or unit the reader assumed (io::Sequence::notes).
+  std::vector<std::string> warnings() const override { return seq_.notes(); }
+
  private:
   io::Sequence seq_;
   std::vector<std::size_t> selected_;

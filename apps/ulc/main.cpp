@@ -7,6 +7,7 @@
 #include <string>
 
 #include "commands.hpp"
+#include "interrupt.hpp"
 #include "ulc/io/io_error.hpp"
 #include "ulc/version.hpp"
 #include "usage_error.hpp"
@@ -53,6 +54,7 @@ int main(int argc, char** argv) {
   }
   for (const auto& c : kCommands) {
     if (name != c.name) continue;
+    ulc::app::install_interrupt_handler(c.name);
     try {
       return c.run(argc - 1, argv + 1);
     } catch (const ulc::app::UsageError& e) {

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "ulc/io/atomic_file.hpp"
 #include "ulc/io/io_error.hpp"
 
 namespace ulc::app {
@@ -94,8 +95,10 @@ void Image::text(int x, int y, const std::string& s, Rgb c, int scale) {
 }
 
 void Image::write_png(const std::string& path) const {
-  if (!stbi_write_png(path.c_str(), width_, height_, 3, rgb_.data(), width_ * 3))
+  io::AtomicFile file(path);  // never a half-written picture
+  if (!stbi_write_png(file.temporary().c_str(), width_, height_, 3, rgb_.data(), width_ * 3))
     throw io::IoError(path, "", "cannot write PNG file");
+  file.commit();
 }
 
 void draw_points(Image& image, const std::array<int, 4>& area, const View& view,

@@ -154,6 +154,12 @@ void timestamps_seeds(const fs::path& dir) {
   save_text(dir / "no_final_newline.txt", "-0.05\n+0.05\n.15");
   // The first line doubles as a frame file stem: Unix nanoseconds.
   save_text(dir / "nanosecond_stem.txt", "1645000000123456789\n");
+  // Every line a frame file stem: pcl_ros's sec.unpadded-nanosec names, out of name order.
+  save_text(dir / "pcl_ros_stems.txt",
+            "1645000000.52300000\n1645000000.152300000\n1645000000.252300000\n"
+            "1645000000.352300000\n");
+  save_text(dir / "milliseconds.txt", "0\n100\n200\n300\n");
+  save_text(dir / "backwards.txt", "0.1\n0.2\n0.15\n");
 }
 
 ulc::io::PairResult pair_result(const std::string& base, const std::string& target) {

@@ -1,4 +1,5 @@
 // Whole-file reads and writes for the I/O layer, throwing IoError with the path and the reason.
+// Writes are atomic (atomic_file.hpp).
 //
 // Readers load a file into memory once and parse it with ByteReader: the file size is then the
 // bound every later allocation is checked against.
@@ -12,6 +13,7 @@
 #include <system_error>
 #include <vector>
 
+#include "ulc/io/atomic_file.hpp"
 #include "ulc/io/io_error.hpp"
 
 namespace ulc::io {
@@ -36,16 +38,15 @@ inline std::vector<unsigned char> read_file_bytes(const std::filesystem::path& p
   return bytes;
 }
 
+/// Writes `bytes` to `path` atomically (atomic_file.hpp): never a half-written file.
 inline void write_file_bytes(const std::filesystem::path& path,
                              const std::vector<unsigned char>& bytes) {
-  const std::string name = path.string();
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out)
-    throw IoError(name, "", std::string("cannot open for writing: ") + std::strerror(errno));
-  out.write(reinterpret_cast<const char*>(bytes.data()),
-            static_cast<std::streamsize>(bytes.size()));
-  out.flush();
-  if (!out) throw IoError(name, "", "write failed");
+  write_file_atomically(path, bytes.data(), bytes.size());
+}
+
+/// Writes `text` to `path` atomically, as write_file_bytes.
+inline void write_file_text(const std::filesystem::path& path, const std::string& text) {
+  write_file_atomically(path, text.data(), text.size());
 }
 
 }  // namespace ulc::io

@@ -22,6 +22,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "ulc/io/file_bytes.hpp"
 #include "ulc/io/io_error.hpp"
 
 namespace ulc::io {
@@ -108,13 +109,10 @@ inline std::string dump_json(const Json& j) {
   return out;
 }
 
-/// Writes dump_json and a newline; throws IoError when the file cannot be written.
+/// Writes dump_json and a newline, atomically (atomic_file.hpp); throws IoError when the file
+/// cannot be written.
 inline void write_json_file(const std::string& path, const Json& value) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out) throw IoError(path, "", "cannot open file for writing");
-  const std::string text = dump_json(value) + "\n";
-  out.write(text.data(), static_cast<std::streamsize>(text.size()));
-  if (!out) throw IoError(path, "", "write failed");
+  write_file_text(path, dump_json(value) + "\n");
 }
 
 /// A matrix as an array of rows.

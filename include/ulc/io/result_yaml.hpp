@@ -20,12 +20,12 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cstdio>
-#include <fstream>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "ulc/core/lie.hpp"
+#include "ulc/io/file_bytes.hpp"
 #include "ulc/io/io_error.hpp"
 #include "ulc/io/result_file.hpp"
 
@@ -162,13 +162,11 @@ inline std::string results_to_yaml(const std::vector<PairResult>& results,
   return std::string(y.c_str()) + "\n";
 }
 
-/// Writes results_to_yaml to `path`; throws IoError when the file cannot be written.
+/// Writes results_to_yaml to `path` atomically (atomic_file.hpp); throws IoError when the file
+/// cannot be written.
 inline void write_result_yaml(const std::string& path, const std::vector<PairResult>& results,
                               const std::vector<CycleResult>& cycles = {}) {
-  std::ofstream out(path, std::ios::binary);
-  if (!out) throw IoError(path, "", "cannot open for writing");
-  out << results_to_yaml(results, cycles);
-  if (!out.flush()) throw IoError(path, "", "write failed");
+  write_file_text(path, results_to_yaml(results, cycles));
 }
 
 }  // namespace ulc::io

@@ -25,12 +25,12 @@
 
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <string>
 #include <system_error>
 #include <utility>
 #include <vector>
 
+#include "ulc/io/file_bytes.hpp"
 #include "ulc/io/ground_truth.hpp"
 #include "ulc/io/io_error.hpp"
 #include "ulc/io/pcd_write.hpp"
@@ -55,11 +55,7 @@ inline void make_directory(const std::filesystem::path& dir) {
 }
 
 inline void write_text(const std::filesystem::path& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out) throw io::IoError(path.string(), "", "cannot open for writing");
-  out.write(text.data(), static_cast<std::streamsize>(text.size()));
-  out.flush();
-  if (!out) throw io::IoError(path.string(), "", "write failed");
+  io::write_file_text(path, text);  // atomic: never half a file
 }
 
 /// Removes six-digit frame files numbered `count` and above.
