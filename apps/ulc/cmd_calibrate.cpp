@@ -116,6 +116,7 @@ void print_summary(const io::PairResult& r) {
           "(stages.terra.hypotheses)\n",
           tried->size(), terra->at("hypothesis_used").get<double>() + 1.0);
   }
+  for (const auto& d : r.unobservable) std::printf("  free    %s\n", d.words.c_str());
   const Eigen::Vector3d t = r.T_base_target.translation();
   const Eigen::Vector3d rpy = ulc::rpy_from_rotation(r.T_base_target.linear()) * kDeg;
   std::printf("  xyz_m   %9.4f %9.4f %9.4f\n", t.x(), t.y(), t.z());

@@ -50,6 +50,16 @@ struct SequenceExtrinsicResult {
   /// 1 / (H_77 (H^-1)_77) of the joint normal matrix: the share of dt's information that a
   /// change of C cannot explain (1: independent of C, 0: a translation along the road would do).
   double time_observability = 0.0;
+  /// The final solve's information for C at its dt (the joint normal matrix's 6x6 block: a
+  /// left perturbation of C in the base frame, robust weights), the matched target points'
+  /// centroid and covariance in the base frame (m, m^2): what ulc/core/observability.hpp
+  /// judges.
+  /// The geometry alone: whether dt can be told from a translation is time_observability's
+  /// question (with dt marginalised, 10 s town drives fell to 0.003-0.012, as low as the
+  /// tunnel: docs/experiments/degenerate_scenes.md).
+  Mat6d information = Mat6d::Zero();
+  ulc::Vec3d centre = ulc::Vec3d::Zero();
+  ulc::Mat3d covariance = ulc::Mat3d::Zero();
   std::size_t frames = 0, targets = 0, source_points = 0;
   std::size_t correspondences = 0, inliers = 0;
   double rmse = 0.0;   ///< m, inliers at the result

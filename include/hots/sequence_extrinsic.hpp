@@ -151,10 +151,14 @@ struct JointSums {
   double cost = 0.0;
   std::size_t count = 0, inliers = 0;
   double inlier_sq = 0.0;
+  Vec3d sum_y = Vec3d::Zero();  ///< of the matched points C x, base frame (their centre)
+  Mat3d sum_yyT = Mat3d::Zero();
 
   JointSums& operator+=(const JointSums& o) {
     H += o.H;
     g += o.g;
+    sum_y += o.sum_y;
+    sum_yyT += o.sum_yyT;
     cost += o.cost;
     count += o.count;
     inliers += o.inliers;
@@ -386,9 +390,12 @@ class SequenceProblem {
       Vec7 J;
       for (std::size_t p = begin; p < end; ++p) {
         if (planes[p].normal.squaredNorm() == 0.0) continue;
-        const double r = joint_residual(term.points[p].template cast<double>(), C, term.post,
-                                        dposts_[i], planes[p], J);
+        const Vec3d x = term.points[p].template cast<double>();
+        const double r = joint_residual(x, C, term.post, dposts_[i], planes[p], J);
         const double w = stage.kernel.weight(r);
+        const Vec3d y = C * x;
+        acc.sum_y += y;
+        acc.sum_yyT += y * y.transpose();
         acc.H.noalias() += w * J * J.transpose();
         acc.g.noalias() += (w * r) * J;
         acc.cost += stage.kernel.rho(r);
@@ -598,6 +605,12 @@ void take_solve(const Solve& s, const SequenceProblem<S>& problem,
   result.inliers = s.sums.inliers;
   result.rmse = s.sums.rmse();
   result.cost = s.sums.cost;
+  result.information = s.sums.H.topLeftCorner<6, 6>();
+  if (s.sums.count > 0) {
+    const double n = static_cast<double>(s.sums.count);
+    result.centre = s.sums.sum_y / n;
+    result.covariance = s.sums.sum_yyT / n - result.centre * result.centre.transpose();
+  }
 }
 
 }  // namespace sequence_detail

@@ -94,6 +94,15 @@ struct AcceptanceReport {
   /// free: along it, across it and turning about its normal (detail::off_plane_weakest_share).
   double off_ground_overlap = 0.0;
   double ground_share = 0.0;  ///< near points whose normal is within 15 deg of the dominant one
+  /// The agreeing points' information (unit weights) for a left perturbation of the measured
+  /// map's pose in the other map's frame (C, or C^-1 when measured_a), their centroid and
+  /// covariance there (m, m^2): for naming what it leaves free (ulc/core/observability.hpp).
+  ulc::Mat6d information = ulc::Mat6d::Zero();
+  ulc::Vec3d centre = ulc::Vec3d::Zero();
+  ulc::Mat3d covariance = ulc::Mat3d::Zero();
+  /// Every test but the condition passed: the maps agree, so `information` describes the
+  /// scene at the right extrinsic rather than a misregistration.
+  bool maps_agree = false;
 };
 
 namespace detail {
@@ -104,12 +113,14 @@ struct AgreementSums {
   ulc::Mat3d normals = ulc::Mat3d::Zero();  ///< sum n n^T of the near points' planes
   ulc::Vec3d sum_y = ulc::Vec3d::Zero();
   double sum_yy = 0.0;
+  ulc::Mat3d sum_yyT = ulc::Mat3d::Zero();
   AgreementSums& operator+=(const AgreementSums& o) {
     equations += o.equations;
     near += o.near;
     normals += o.normals;
     sum_y += o.sum_y;
     sum_yy += o.sum_yy;
+    sum_yyT += o.sum_yyT;
     return *this;
   }
 };
@@ -180,6 +191,7 @@ void measure_agreement(const ulc::PointCloud<S>& points, const ulc::PlaneCloud<S
           acc.equations.add(J, r);
           acc.sum_y += y;
           acc.sum_yy += y.squaredNorm();
+          acc.sum_yyT += y * y.transpose();
         }
         return acc;
       },
@@ -195,6 +207,9 @@ void measure_agreement(const ulc::PointCloud<S>& points, const ulc::PlaneCloud<S
     const ulc::Vec3d c = sums.sum_y / n;
     const double spread = std::sqrt(std::max(sums.sum_yy / n - c.squaredNorm(), 1e-18));
     report.condition = ulc::scaled_condition(sums.equations.H, c, spread);
+    report.information = sums.equations.H;
+    report.centre = c;
+    report.covariance = sums.sum_yyT / n - c * c.transpose();
     report.rmse = std::sqrt(sums.equations.cost / n);
     report.directional_overlap = weakest_share(sums.equations.H, sums.near.H, c, spread);
     const Eigen::SelfAdjointEigenSolver<ulc::Mat3d> normals(sums.normals);
@@ -244,9 +259,10 @@ AcceptanceReport assess(const std::vector<Vec3<S>>& map_a, const std::vector<Vec
   } else if (report.directional_overlap < options.min_directional_overlap) {
     report.reason = "the maps disagree on the ground itself (its height or tilt)";
   } else if (report.condition < options.min_condition) {
+    report.maps_agree = true;
     report.reason = "the points on which the maps agree leave a direction unconstrained";
   } else {
-    report.accepted = true;
+    report.maps_agree = report.accepted = true;
   }
   return report;
 }

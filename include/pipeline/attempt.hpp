@@ -26,6 +26,7 @@
 #include "hots/hots.hpp"
 #include "jeep/jeep.hpp"
 #include "odometry/run_odometry.hpp"
+#include "pipeline/observability_verdict.hpp"
 #include "pipeline/options.hpp"
 #include "pipeline/pair_calibration.hpp"
 #include "ulc/core/frame_range.hpp"
@@ -112,6 +113,7 @@ inline JeepReport jeep_report(const jeep::JeepResult& j, const Isometry3d& initi
   r.two_way_gap_rotation = j.two_way.gap_rotation;
   r.start_basins = j.start_search.basins;
   r.start_chosen = j.start_search.chosen;
+  r.observability = jeep_observability(j.acceptance, j.extrinsic);
   r.seconds = seconds;
   r.target_speed_mps = target_speed(j);
   return r;
@@ -209,6 +211,7 @@ inline void add_refine(HotsReport& h, const hots::RefineResult& r, double second
   h.covariance_6x6 = r.covariance_6x6;
   h.statistics = r.statistics;
   h.spread_curve = r.spread_curve;
+  h.observability = hots_observability(r.statistics.sequence);
   h.seconds = seconds;
 }
 

@@ -26,6 +26,7 @@
 #include "pipeline/map_terra_options.hpp"
 #include "pipeline/stages.hpp"
 #include "terra/search_params.hpp"
+#include "ulc/core/observability_types.hpp"
 #include "ulc/core/registration_types.hpp"
 #include "ulc/core/types.hpp"
 
@@ -40,7 +41,11 @@ enum class CalibrateStatus {
   hots_failed,       ///< the odometry before HOTS or HOTS itself failed (see hots->status)
   // What the data cannot vouch for (pipeline/vouch.hpp; the extrinsic is kept for inspection):
   time_offset_unestimated,  ///< no clock offset estimated or given, and a lag moves it (clock)
-  point_times_missing       ///< a LiDAR's sweeps could not be deskewed at this speed (point_times)
+  point_times_missing,      ///< a LiDAR's sweeps could not be deskewed at this speed (point_times)
+  /// The final problem leaves a direction of the extrinsic free (a straight road, a tunnel):
+  /// `unobservable` names it; the extrinsic's other directions are the data's
+  /// (pipeline/observability_verdict.hpp).
+  degenerate
 };
 
 inline const char* to_string(CalibrateStatus s) {
@@ -59,6 +64,8 @@ inline const char* to_string(CalibrateStatus s) {
       return "time_offset_unestimated";
     case CalibrateStatus::point_times_missing:
       return "point_times_missing";
+    case CalibrateStatus::degenerate:
+      return "degenerate";
     default:
       return "hots_failed";
   }
@@ -133,6 +140,10 @@ struct JeepReport {
   /// JEEP failed (rejected or not settled) and HOTS ran from its extrinsic to judge it
   /// (CalibrateOptions::tuning.hypotheses.hots_judges_jeep): the pair's status says which won.
   bool judged_by_hots = false;
+  /// The final map-to-map registration's observability of the extrinsic (the acceptance's
+  /// agreeing points, ulc/core/observability.hpp), when the maps agree (else nothing: the
+  /// information of a misregistration says nothing about the scene).
+  std::optional<Observability> observability;
   double seconds = 0.0;
   /// The target's largest speed over the pairs (a's twists carried to b's origin), m/s: what
   /// an unestimated clock offset or an undeskewed sweep turns into a translation error.
@@ -161,6 +172,9 @@ struct HotsReport {
   Mat6d covariance_6x6 = Mat6d::Zero();           ///< [rho; phi], left
   hots::RefineStatistics statistics;
   std::vector<std::pair<double, double>> spread_curve;  ///< (offset s, spread), last pass
+  /// The whole-sequence step's observability of the extrinsic (ulc/core/observability.hpp),
+  /// when that step ran.
+  std::optional<Observability> observability;
   double odometry_seconds = 0.0;
   double seconds = 0.0;  ///< hots::refine alone
 };
@@ -250,6 +264,13 @@ struct PairCalibration {
   /// not run or skipped itself): xi = [rho; phi] with T_true = exp(xi) T (left, base frame; m,
   /// rad). docs/pipeline.md, "The covariance".
   std::optional<Mat6d> covariance_6x6;
+  /// Observability of the extrinsic in the final problem (pipeline/observability_verdict.hpp):
+  /// which problem was judged ("hots": the whole-sequence step; "jeep": the final map-to-map
+  /// registration; empty: none), its weakest direction's share, and the directions it leaves
+  /// free (non-empty exactly when status is degenerate).
+  std::string observability_problem;
+  double weakest_share = 0.0;
+  std::vector<UnobservableDirection> unobservable;
   StageTimings timing_s;
   // What the data cannot vouch for (vouch.hpp): the clock offset's provenance and effect
   // (set whenever JEEP's or HOTS's translation is the answer), and each LiDAR's point times.

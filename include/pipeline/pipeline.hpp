@@ -41,6 +41,10 @@
 //     optima, then those of the search not kept) run, each needing JEEP's own acceptance before
 //     HOTS. With none, the best one's failure is reported. stages.terra.hypotheses lists each one
 //     tried and its outcome; timings sum over all of them.
+//   - Degenerate verdict (observability_verdict.hpp): when the call ends, the final problem's
+//     information for the extrinsic (HOTS's whole-sequence step, else JEEP's final
+//     registration) is judged; a direction it leaves free makes the status degenerate, over
+//     ok or a stage's failure, and `unobservable` names it.
 //   - Progress: options.progress(stage, fraction in [0, 1]) on the calling thread; stages
 //     "terra", "jeep", "odometry", "hots" (HOTS reports only 0 and 1); a later hypothesis's
 //     stages carry " (hypothesis k)".
@@ -77,6 +81,7 @@ struct Finish {
   PairCalibration& result;
   std::chrono::steady_clock::time_point start;
   PairCalibration operator()(CalibrateStatus status, std::string reason) const {
+    judge_observability(result, status, reason);
     result.status = status;
     result.success = status == CalibrateStatus::ok;
     result.reason = std::move(reason);

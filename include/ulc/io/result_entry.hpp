@@ -124,6 +124,10 @@ inline Json jeep_to_json(const JeepReport& r) {
   j["start_basins"] = r.start_basins;
   j["start_chosen"] = r.start_chosen;
   j["judged_by_hots"] = r.judged_by_hots;
+  // The final registration's weakest direction (ulc/core/observability.hpp), null when its
+  // maps disagree.
+  j["weakest_share"] = r.observability ? Json(r.observability->weakest_share) : Json();
+  j["shares"] = r.observability ? vector_to_json(r.observability->shares) : Json();
   j["seconds"] = r.seconds;
   j["target_speed_mps"] = r.target_speed_mps;
   return j;
@@ -184,6 +188,10 @@ inline Json hots_to_json(const HotsReport& h) {
   for (const double half : s.sequence.half_time_offset_s) halves.push_back(half);
   j["half_time_offsets_s"] = std::move(halves);
   j["time_observability"] = s.sequence.time_observability;
+  // The whole-sequence step's weakest direction (ulc/core/observability.hpp), null when the
+  // step did not run.
+  j["weakest_share"] = h.observability ? Json(h.observability->weakest_share) : Json();
+  j["shares"] = h.observability ? vector_to_json(h.observability->shares) : Json();
   Json curve = Json::array();
   for (const auto& [offset, spread] : h.spread_curve) {
     Json point = Json::array();
@@ -253,6 +261,9 @@ inline PairResult to_pair_result(const PairCalibration& c, const std::string& ba
   if (c.covariance_6x6) r.covariance_6x6 = *c.covariance_6x6;
   if (c.clock) r.clock = clock_to_json(*c.clock);
   r.point_times = point_times_to_json(c.point_times_base, c.point_times_target);
+  r.observability_problem = c.observability_problem;
+  if (!c.observability_problem.empty()) r.weakest_share = c.weakest_share;
+  r.unobservable = c.unobservable;
   r.stages = Json::object();
   if (c.terra) r.stages["terra"] = terra_to_json(*c.terra);
   if (c.jeep) r.stages["jeep"] = jeep_to_json(*c.jeep);

@@ -12,6 +12,11 @@
 //   - a top-level "cycles" array next to "results", written when there are cycles:
 //     {"lidars": [base, i, j], "status", "reason", "rotation_deg", "translation_m"}, the closure
 //     error of T_base_i * T_i_j * T_base_j^-1 (null when the i -> j calibration failed).
+//
+// Observability (pipeline/observability_verdict.hpp; additive, older files read as "not
+// judged"): "observability": {"problem": "hots" | "jeep", "weakest_share"} (null when no
+// problem was judged) and "unobservable": [{"vector": [t; S phi], "share", "words"}, ...], the
+// directions the final problem leaves free (status "degenerate"), empty otherwise.
 #pragma once
 
 #include <Eigen/Geometry>
@@ -21,6 +26,7 @@
 #include <vector>
 
 #include "ulc/core/lie.hpp"
+#include "ulc/core/observability_types.hpp"
 #include "ulc/io/json_file.hpp"
 
 namespace ulc::io {
@@ -44,6 +50,11 @@ struct PairResult {
   /// Null: not written.
   Json clock;
   Json point_times;
+  /// Observability: the problem judged ("hots", "jeep"; empty: none), its weakest share, and
+  /// the directions it leaves free (ulc/core/observability.hpp).
+  std::string observability_problem;
+  std::optional<double> weakest_share;
+  std::vector<ulc::UnobservableDirection> unobservable;
 };
 
 /// The cycle base -> i -> j -> base: how far T_base_i * T_i_j * T_base_j^-1 is from identity.
@@ -60,6 +71,57 @@ struct ResultDocument {
   std::vector<PairResult> results;
   std::vector<CycleResult> cycles;
 };
+
+/// {"problem", "weakest_share"}, or null when no problem was judged.
+inline Json observability_to_json(const PairResult& r) {
+  if (r.observability_problem.empty() || !r.weakest_share) return Json();
+  Json j = Json::object();
+  j["problem"] = r.observability_problem;
+  j["weakest_share"] = *r.weakest_share;
+  return j;
+}
+
+inline Json unobservable_to_json(const std::vector<ulc::UnobservableDirection>& free) {
+  Json list = Json::array();
+  for (const auto& d : free) {
+    Json j = Json::object();
+    j["vector"] = vector_to_json(d.vector);
+    j["share"] = d.share;
+    j["words"] = d.words;
+    list.push_back(std::move(j));
+  }
+  return list;
+}
+
+/// "observability" and "unobservable" of an entry into r (absent keys: not judged).
+inline void observability_from_json(const Json& e, const std::string& file,
+                                    const std::string& where, PairResult& r) {
+  if (const Json* o = find_member(e, "observability"); o && o->is_object()) {
+    if (const Json* p = find_member(*o, "problem"); p && p->is_string())
+      r.observability_problem = p->get<std::string>();
+    if (const Json* w = find_member(*o, "weakest_share"); w && w->is_number())
+      r.weakest_share = json_to_number(*w, file, where + ".observability.weakest_share");
+  }
+  const Json* list = find_member(e, "unobservable");
+  if (!list) return;
+  if (!list->is_array()) throw IoError(file, where + ".unobservable", "expected an array");
+  for (std::size_t k = 0; k < list->size(); ++k) {
+    const std::string at = where + ".unobservable[" + std::to_string(k) + "]";
+    const Json& d = (*list)[k];
+    const Json* v = find_member(d, "vector");
+    if (!v || !v->is_array() || v->size() != 6)
+      throw IoError(file, at + ".vector", "expected an array of 6 numbers");
+    ulc::UnobservableDirection u;
+    for (std::size_t i = 0; i < 6; ++i)
+      u.vector[static_cast<Eigen::Index>(i)] =
+          json_to_number((*v)[i], file, at + ".vector[" + std::to_string(i) + "]");
+    if (const Json* s = find_member(d, "share"); s && s->is_number())
+      u.share = json_to_number(*s, file, at + ".share");
+    if (const Json* w = find_member(d, "words"); w && w->is_string())
+      u.words = w->get<std::string>();
+    r.unobservable.push_back(std::move(u));
+  }
+}
 
 inline Json to_json(const PairResult& r) {
   constexpr double kDeg = 180.0 / 3.14159265358979323846;
@@ -78,6 +140,8 @@ inline Json to_json(const PairResult& r) {
   e["covariance_6x6"] = r.covariance_6x6 ? matrix_to_json(*r.covariance_6x6) : Json();
   if (!r.clock.is_null()) e["clock"] = r.clock;
   if (!r.point_times.is_null()) e["point_times"] = r.point_times;
+  e["observability"] = observability_to_json(r);
+  e["unobservable"] = unobservable_to_json(r.unobservable);
   e["stages"] = r.stages;
   e["timing_s"] = r.timing_s;
   if (!r.via.empty()) {
@@ -146,6 +210,7 @@ inline std::vector<PairResult> results_from_json(const Json& doc, const std::str
       r.time_offset_s = json_to_number(*dt, file, where + ".time_offset_s");
     if (const Json* c = find_member(e, "covariance_6x6"); c && c->is_array())
       r.covariance_6x6 = json_to_matrix<6, 6>(*c, file, where + ".covariance_6x6");
+    observability_from_json(e, file, where, r);
     if (const Json* s = find_member(e, "stages"); s && s->is_object()) r.stages = *s;
     if (const Json* s = find_member(e, "timing_s"); s && s->is_object()) r.timing_s = *s;
     if (const Json* c = find_member(e, "clock"); c && c->is_object()) r.clock = *c;

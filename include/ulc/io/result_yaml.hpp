@@ -13,7 +13,8 @@
 // number as YAML's .nan / .inf / -.inf, a missing one as null.
 // Written with yaml-cpp's emitter (Debian's libyaml-cpp-dev): component ulc::results.
 // A routed entry (result_file.hpp) adds `via` and `direct_status` / `direct_reason`; a rig's
-// cycle closures follow the results as a top-level `cycles` list, the JSON file's fields.
+// cycle closures follow the results as a top-level `cycles` list, the JSON file's fields. A
+// degenerate entry lists its free directions under `unobservable` (words, vector, share).
 #pragma once
 
 #include <yaml-cpp/yaml.h>
@@ -67,6 +68,20 @@ void row(YAML::Emitter& y, const char* key, const V& v) {
   row(y, v);
 }
 
+/// `unobservable:` the free directions (words and vector), written only when there are some.
+inline void unobservable(YAML::Emitter& y, const std::vector<ulc::UnobservableDirection>& free) {
+  if (free.empty()) return;
+  y << YAML::Key << "unobservable" << YAML::Value << YAML::BeginSeq;
+  for (const auto& d : free) {
+    y << YAML::BeginMap;
+    quoted(y, "words", d.words);
+    row(y, "vector", d.vector);
+    y << YAML::Key << "share" << YAML::Value << d.share;
+    y << YAML::EndMap;
+  }
+  y << YAML::EndSeq;
+}
+
 inline void result(YAML::Emitter& y, const PairResult& r) {
   constexpr double kDeg = 180.0 / 3.14159265358979323846;
   const Eigen::Isometry3d& T = r.T_base_target;
@@ -85,6 +100,7 @@ inline void result(YAML::Emitter& y, const PairResult& r) {
     quoted(y, "direct_reason", r.direct_reason);
   }
   number(y, "time_offset_s", r.time_offset_s);
+  unobservable(y, r.unobservable);
   y << YAML::Key << "T_base_target" << YAML::Value << YAML::BeginSeq;
   for (int i = 0; i < 4; ++i) row(y, Eigen::Vector4d(T.matrix().row(i).transpose()));
   y << YAML::EndSeq;
