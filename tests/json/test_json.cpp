@@ -204,9 +204,10 @@ TEST_CASE("result files: keys and types a reader relies on", "[json][result]") {
   for (auto it = e.begin(); it != e.end(); ++it) keys.push_back(it.key());
   CHECK(keys == std::vector<std::string>{"base", "target", "success", "status", "reason",
                                          "T_base_target", "translation_m", "rotation_quat_wxyz",
-                                         "rpy_deg", "time_offset_s", "covariance_6x6", "stages",
-                                         "timing_s"});
+                                         "rpy_deg", "time_offset_s", "covariance_6x6",
+                                         "observability", "unobservable", "stages", "timing_s"});
   CHECK(e.at("time_offset_s").is_null());
+  CHECK(e.at("unobservable").is_array());
   CHECK(e.at("covariance_6x6").is_null());
   CHECK(doc.at("cycles")[0].at("translation_m").is_null());
   const auto cycles = ulc::io::cycles_from_json(parse_json(ulc::io::dump_json(doc)), "r.json");
