@@ -203,13 +203,11 @@ int main(int argc, char** argv) {
   app.add_option("--runs", c.runs, "runs per scenario (default 10)")
       ->type_name("N")
       ->check(CLI::PositiveNumber);
-  app.add_option("--first-run", c.first_run, "first run's index (default 0)")->type_name("K");
+  ulc_bench::add_first_run_option(app, c.first_run);
   app.add_flag("--estimate-offset", c.estimate_offset,
                "let HOTS estimate the clock offset (default: told the true one)");
   app.add_flag("--parked", c.parked, "one frame per LiDAR of a parked rig (JEEP's covariance)");
-  app.add_option("--threads", c.threads, "worker threads (default 2)")
-      ->type_name("N")
-      ->check(CLI::PositiveNumber);
+  ulc_bench::add_threads_option(app, c.threads);
   CLI11_PARSE(app, argc, argv);
   bench(c);
   return 0;

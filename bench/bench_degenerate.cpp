@@ -210,10 +210,8 @@ int main(int argc, char** argv) {
       ->delimiter(',')
       ->type_name("S:T,...");
   app.add_option("--runs", c.runs, "runs per drive")->type_name("N")->check(CLI::PositiveNumber);
-  app.add_option("--first-run", c.first_run, "first run's index (default 0)")->type_name("K");
-  app.add_option("--threads", c.threads, "worker threads (default 2)")
-      ->type_name("N")
-      ->check(CLI::PositiveNumber);
+  ulc_bench::add_first_run_option(app, c.first_run);
+  ulc_bench::add_threads_option(app, c.threads);
   app.add_flag("--per-run", c.per_run, "print every run's row before the summary");
   CLI11_PARSE(app, argc, argv);
   bench(c);

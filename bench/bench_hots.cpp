@@ -527,13 +527,11 @@ int main(int argc, char** argv) {
   app.add_option("--runs", c.runs, "runs per scenario (default 10)")
       ->type_name("N")
       ->check(CLI::PositiveNumber);
-  app.add_option("--first-run", c.first_run, "first run's index (default 0)")->type_name("K");
+  ulc_bench::add_first_run_option(app, c.first_run);
   app.add_option("--decimation", c.decimation, "keep every Nth point (default 1)")
       ->type_name("N")
       ->check(CLI::PositiveNumber);
-  app.add_option("--threads", c.threads, "worker threads (default 2)")
-      ->type_name("N")
-      ->check(CLI::PositiveNumber);
+  ulc_bench::add_threads_option(app, c.threads);
   app.add_option("--spread-png", c.spread_png, "draw run 0's spread curves to PREFIX_...png")
       ->type_name("PREFIX");
   app.add_option_function<double>(

@@ -630,9 +630,7 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   app.add_option("--seconds", c.seconds, "simulated drive (default 20)")->type_name("S");
   app.add_option("--seed", c.seed, "disturbance seed (default 1)")->type_name("N");
-  app.add_option("--threads", c.threads, "worker threads (default 2)")
-      ->type_name("N")
-      ->check(CLI::PositiveNumber);
+  ulc_bench::add_threads_option(app, c.threads);
   app.add_option("--cache", c.cache, "folder of the cached drives (default /tmp/ulc_jeep_cache)")
       ->type_name("DIR");
   app.add_option("--png", c.png_dir, "robustness and frames-sweep heat maps as PNG")

@@ -213,9 +213,7 @@ int main(int argc, char** argv) {
   app.add_option("--disturbances", c.disturbances, "disturbed starts (default 5)")
       ->type_name("N")
       ->check(CLI::PositiveNumber);
-  app.add_option("--threads", c.threads, "worker threads (default 2)")
-      ->type_name("N")
-      ->check(CLI::PositiveNumber);
+  ulc_bench::add_threads_option(app, c.threads);
   CLI11_PARSE(app, argc, argv);
   run(c);
   return 0;

@@ -191,9 +191,7 @@ int main(int argc, char** argv) {
       ->type_name("N")
       ->check(CLI::PositiveNumber);
   app.add_option("--seed", c.seed, "simulation seed (default 1)")->type_name("N");
-  app.add_option("--threads", c.threads, "worker threads (default 2)")
-      ->type_name("N")
-      ->check(CLI::PositiveNumber);
+  ulc_bench::add_threads_option(app, c.threads);
   app.add_flag_callback(
       "--no-route", [&] { c.route = false; }, "no routes through other targets");
   app.add_flag_callback(

@@ -710,9 +710,7 @@ int main(int argc, char** argv) {
   app.add_option("--coarse-stride", acc.coarse_stride_deg,
                  "--accuracy: coarse stride in degrees (default 10)")
       ->type_name("DEG");
-  app.add_option("--threads", acc.threads, "worker threads (default 2)")
-      ->type_name("N")
-      ->check(CLI::PositiveNumber);
+  ulc_bench::add_threads_option(app, acc.threads);
   CLI11_PARSE(app, argc, argv);
   const bool pairs_given = pairs_option->count() > 0;
   if (maps) {

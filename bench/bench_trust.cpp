@@ -194,10 +194,8 @@ int main(int argc, char** argv) {
   app.add_option("--scenarios", c.scenarios, "scenarios")->delimiter(',')->type_name("A,B,...");
   app.add_option("--seconds", c.seconds, "simulated drive")->type_name("S");
   app.add_option("--runs", c.runs, "runs per scenario")->type_name("N")->check(CLI::PositiveNumber);
-  app.add_option("--first-run", c.first_run, "first run's index (default 0)")->type_name("K");
-  app.add_option("--threads", c.threads, "worker threads (default 2)")
-      ->type_name("N")
-      ->check(CLI::PositiveNumber);
+  ulc_bench::add_first_run_option(app, c.first_run);
+  ulc_bench::add_threads_option(app, c.threads);
   CLI11_PARSE(app, argc, argv);
   bench(c);
   return 0;

@@ -41,6 +41,18 @@ inline void add_options(CLI::App& app, Options& options) {
       ->check(CLI::PositiveNumber);
 }
 
+/// --threads N: the worker threads of the stages measured (a TBB arena; the default is 2).
+inline void add_threads_option(CLI::App& app, int& threads) {
+  app.add_option("--threads", threads, "worker threads (default 2)")
+      ->type_name("N")
+      ->check(CLI::PositiveNumber);
+}
+
+/// --first-run K: the index of the first seeded run, to extend a measurement or hold seeds out.
+inline void add_first_run_option(CLI::App& app, std::size_t& first_run) {
+  app.add_option("--first-run", first_run, "first run's index (default 0)")->type_name("K");
+}
+
 struct Machine {
   unsigned threads = 0;  ///< std::thread::hardware_concurrency(), what nproc reports
   std::string cpu;       ///< "model name" from /proc/cpuinfo, or "unknown"
