@@ -30,6 +30,7 @@
 #include <limits>
 #include <vector>
 
+#include "pipeline/vouch_options.hpp"
 #include "ulc/core/lie.hpp"
 #include "ulc/core/types.hpp"
 
@@ -42,14 +43,6 @@ struct MotionLag {
 };
 
 /// Noise floors of an odometry's motion over a ~1 s baseline, and the search.
-struct MotionLagOptions {
-  double max_lag_s = 0.25;
-  double step_s = 0.001;
-  double baseline_s = 0.6;
-  double rate_noise = 0.03;      ///< rad/s
-  double velocity_noise = 0.03;  ///< m/s
-};
-
 namespace lag_detail {
 
 struct Motion {

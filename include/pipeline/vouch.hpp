@@ -5,7 +5,7 @@
 //     offset (CalibrateOptions::time_offset_s), JEEP pairs frames by their own clocks: an
 //     offset d moves the translation by d times the target's speed (50 ms at 7.4 m/s: 37 cm),
 //     and JEEP's maps still agree. The check (VouchOptions): the speed over JEEP's frames; if
-//     no plausible offset (max_lag_s) can move the translation by more than
+//     no plausible offset (lag.max_lag_s) can move the translation by more than
 //     max_translation_effect_m, "slow". Otherwise the lag between the two LiDARs' motions
 //     (motion_lag.hpp, single-LiDAR odometries over lag_window_s of frames from frame_index):
 //     (|lag| + sigma_factor sigma) * speed within the bar: "lag_within_bar", ok; a lag whose
@@ -81,7 +81,8 @@ inline std::size_t frames_within(const std::vector<double>& times, double second
   return n;
 }
 
-/// Each LiDAR's own odometry over the window, then the lag between their rotation rates.
+/// Each LiDAR's own odometry over the window, then the lag between their motions
+/// (motion_lag.hpp: rotation rates and speeds).
 template <class FA, class FB>
 MotionLag motion_lag(const AttemptInputs<FA, FB>& in, const Isometry3d& T_ab) {
   const VouchOptions& v = in.options.tuning.vouch;
@@ -97,13 +98,7 @@ MotionLag motion_lag(const AttemptInputs<FA, FB>& in, const Isometry3d& T_ab) {
   const auto odo_b = odometry::run_single_odometry(FirstFrames<ViewB>{&in.b.frames, nb}, tb,
                                                    in.options.tuning.odometry);
   if (odo_a.poses_a.empty() || odo_b.poses_a.empty()) return {};
-  MotionLagOptions o;
-  o.max_lag_s = v.max_lag_s;
-  o.step_s = v.lag_step_s;
-  o.baseline_s = v.lag_baseline_s;
-  o.rate_noise = v.rate_noise;
-  o.velocity_noise = v.velocity_noise;
-  return estimate_motion_lag(odo_a.poses_a, ta, odo_b.poses_a, tb, T_ab, o);
+  return estimate_motion_lag(odo_a.poses_a, ta, odo_b.poses_a, tb, T_ab, v.lag);
 }
 
 /// The clock's verdict on a JEEP translation with no offset estimated or given (see the top).
@@ -125,10 +120,10 @@ ClockReport unestimated_clock(const AttemptInputs<FA, FB>& in, const PairCalibra
     c.note = head;
     return c;
   }
-  if (c.speed_mps * v.max_lag_s <= v.max_translation_effect_m) {
+  if (c.speed_mps * v.lag.max_lag_s <= v.max_translation_effect_m) {
     c.verdict = "slow";
-    c.note = head + "; even " + fixed(v.max_lag_s * 1000.0, 0) + " ms would move it by " +
-             cm(c.speed_mps * v.max_lag_s) + " at most";
+    c.note = head + "; even " + fixed(v.lag.max_lag_s * 1000.0, 0) + " ms would move it by " +
+             cm(c.speed_mps * v.lag.max_lag_s) + " at most";
     return c;
   }
   const MotionLag lag = motion_lag(in, r.T_base_target);

@@ -6,25 +6,31 @@
 
 namespace ulc {
 
+/// The lag search of motion_lag.hpp.
+struct MotionLagOptions {
+  /// The lag is searched within +- this (s).
+  double max_lag_s = 0.25;
+  double step_s = 0.001;  ///< grid of the search before its parabola refinement (s)
+  /// The motions compared: rotation rates and velocities over this baseline (s), normalised by
+  /// noise levels no smaller than these floors. The rate floor is high on purpose: a straight
+  /// drive's rates are its bumps' pitch and roll, which the two LiDARs' frames alias
+  /// differently; only turns (0.1-0.5 rad/s) should count.
+  double baseline_s = 0.6;
+  double rate_noise = 0.03;      ///< rad/s
+  double velocity_noise = 0.03;  ///< m/s
+};
+
 struct VouchOptions {
   /// How far an unestimated clock offset, or a sweep that could not be deskewed, may move the
   /// translation before the result stops being a success (m). Half the 10 cm of a success
   /// (the paper's threshold) leaves the rest to the registration itself; the benchmark
   /// bench_clocks measures both sides (docs/experiments/unestimated_clocks.md).
   double max_translation_effect_m = 0.05;
-  /// The lag between the two LiDARs' motions is searched within +- this (s); an offset of this
-  /// size is also what "any plausible offset" means for a slow rig.
-  double max_lag_s = 0.25;
-  double lag_step_s = 0.001;  ///< grid of the lag search before its parabola refinement (s)
-  /// The motions compared: rotation rates and velocities over this baseline (s), normalised by
-  /// noise levels no smaller than these floors (motion_lag.hpp).
-  /// The rate floor is high on purpose: a straight drive's rates are its bumps' pitch and roll,
-  /// which the two LiDARs' frames alias differently; only turns (0.1-0.5 rad/s) should count.
-  double lag_baseline_s = 0.6;
-  double rate_noise = 0.03;      ///< rad/s
-  double velocity_noise = 0.03;  ///< m/s
+  /// The lag search between the two LiDARs' motions (motion_lag.hpp); its max_lag_s is also
+  /// what "any plausible offset" means for a slow rig.
+  MotionLagOptions lag;
   /// Seconds of each LiDAR's frames (from frame_index) whose single-LiDAR odometries give the
-  /// rotation rates the lag is estimated from: long enough to hold a turn.
+  /// motions the lag is estimated from: long enough to hold a turn.
   double lag_window_s = 30.0;
   /// The lag counts as bounded when (|lag| + sigma_factor * sigma) * speed is within
   /// max_translation_effect_m.
