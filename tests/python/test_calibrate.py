@@ -142,3 +142,16 @@ def test_initial_guess_without_terra(drive, frames):
     assert result.success, result.reason
     rotation_deg, translation_m = errors(result.T_base_target, T)
     assert rotation_deg < 0.5 and translation_m < 0.05
+
+
+def test_clouds_with_a_points_attribute_are_read_as_arrays(frames):
+    """Open3D's PointCloud is read through numpy.asarray(cloud.points)."""
+    class Cloud:
+        def __init__(self, xyz):
+            self.points = xyz
+
+    a, b = frames["lidar64"]["frames"][0], frames["lidar32"]["frames"][0]
+    from_arrays = ulc.calibrate(a[:, :3], b[:, :3], stages="terra")
+    from_clouds = ulc.calibrate(Cloud(a[:, :3]), Cloud(b[:, :3]), stages="terra")
+    assert from_arrays.success
+    np.testing.assert_array_equal(from_clouds.T_base_target, from_arrays.T_base_target)
