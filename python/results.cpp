@@ -4,6 +4,7 @@
 
 #include <vector>
 
+#include "errors.hpp"
 #include "frames.hpp"
 #include "ulc/io/result_yaml.hpp"
 
@@ -32,14 +33,16 @@ std::string json_text(const io::ResultDocument& d) {
   return io::dump_json(io::results_to_json(d.results, d.cycles)) + "\n";
 }
 
-/// Writes the document as `ulc calibrate --output PATH [--format FORMAT]` does.
+/// Writes the document as `ulc calibrate --output PATH [--format FORMAT]` does (atomically).
 void write(const io::ResultDocument& d, const std::string& path, const std::string& format) {
-  if (format == "yaml")
-    io::write_result_yaml(path, d.results, d.cycles);
-  else if (format == "json")
-    io::write_result_file(path, d.results, d.cycles);
-  else
-    throw py::value_error("format must be 'json' or 'yaml', got '" + format + "'");
+  if (format != "json" && format != "yaml")
+    raise_error("ulc calibrate: option '--format': '" + format + "' is not json or yaml");
+  with_cli_errors("calibrate", [&] {
+    if (format == "yaml")
+      io::write_result_yaml(path, d.results, d.cycles);
+    else
+      io::write_result_file(path, d.results, d.cycles);
+  });
 }
 
 py::dict cycle_dict(const io::CycleResult& c) {

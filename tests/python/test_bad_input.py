@@ -79,3 +79,11 @@ def test_a_damaged_cloud_file_is_named(tmp_path):
 def test_unknown_scenario():
     with pytest.raises(ulc.Error, match="unknown scenario 'nope'"):
         ulc.simulate("nope")
+
+
+def test_writing_into_a_missing_folder_is_named(drive, tmp_path):
+    result = ulc.calibrate(lidar(drive, "lidar64"), lidar(drive, "lidar32"), stages="terra")
+    with pytest.raises(ulc.Error, match="nowhere"):
+        result.write(str(tmp_path / "nowhere" / "r.json"))
+    with pytest.raises(ulc.Error, match="'xml' is not json or yaml"):
+        result.write(str(tmp_path / "r.xml"), format="xml")
