@@ -6,22 +6,19 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
-#include <optional>
 #include <string>
 #include <vector>
 
-#include "calibrate_frames.hpp"
 #include "calibration_report.hpp"
 #include "command_line.hpp"
 #include "commands.hpp"
 #include "fused_cloud.hpp"
-#include "initial_extrinsic.hpp"
 #include "lidar_input.hpp"
 #include "pipeline/calibrate.hpp"
 #include "pipeline/rig.hpp"
 #include "progress.hpp"
 #include "rig_run.hpp"
-#include "ulc/io/result_entry.hpp"
+#include "ulc/core/lie.hpp"
 #include "ulc/io/result_file.hpp"
 #include "ulc/io/result_yaml.hpp"
 
