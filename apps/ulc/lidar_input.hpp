@@ -115,6 +115,9 @@ void add_input_options(CLI::App& app, InputArgs& args);
 void add_frame_time_option(CLI::App& app, InputArgs& args);
 /// Reads them back (UsageError for a negative start or a duration that is not positive).
 InputOptions input_options(const InputArgs& args, const std::string& command);
+/// The same from values (unset: not given); frame_time is "header" or "receive".
+InputOptions input_options(std::optional<double> start_s, std::optional<double> duration_s,
+                           const std::string& frame_time, const std::string& command);
 
 /// Prints each input's warnings on stderr as "ulc COMMAND: warning: SOURCE: ...".
 void print_input_warnings(const std::vector<std::unique_ptr<LidarInput>>& inputs,

@@ -65,6 +65,7 @@
 //   - Nothing here throws or prints; results are the same for any number of threads.
 #pragma once
 
+#include <functional>
 #include <utility>
 
 #include "hots/refine_statistics.hpp"
@@ -75,9 +76,12 @@ namespace hots {
 
 /// See the header comment. a and b are LidarSequences with their odometry poses; S is the
 /// scalar of the prepared point clouds (float is plenty).
+/// progress(fraction) is called on the calling thread after each of its six phases (preparation,
+/// hierarchies, cross links, graph, solve, sequence step), with the phases done over six.
 template <typename S = float, class SeqA, class SeqB>
 RefineResult refine(const SeqA& a, const SeqB& b, const Isometry3d& extrinsic,
-                    const RefineOptions& options = {}) {
+                    const RefineOptions& options = {},
+                    const std::function<void(double)>& progress = {}) {
   namespace d = hots_detail;
   RefineResult result;
   result.extrinsic = extrinsic;
@@ -89,21 +93,29 @@ RefineResult refine(const SeqA& a, const SeqB& b, const Isometry3d& extrinsic,
     result.reason = why;
     return result;
   };
+  auto phase_done = [&progress](int phase) {
+    if (progress) progress(phase / 6.0);
+  };
   if (const char* why = d::input_problem(a, b, extrinsic, options))
     return fail(RefineStatus::invalid_input, why);
   RefineStatistics& st = result.statistics;
   d::RefineState<S> s(a, b);
   s.mapa_mapb = d::map_b_in_map_a(s.a, s.b, extrinsic, options.time_offset_s);
   d::prepare_lidars(a, b, s, options, st);
+  phase_done(1);
   d::build_hierarchies(s, options, st);
+  phase_done(2);
   if (!d::link_lidars(s, options.time_offset_s, options, st))
     return fail(RefineStatus::extrinsic_unconfirmed,
                 "too few of the cross links (b's submaps registered to a's through the "
                 "extrinsic) agree with it: the two LiDARs' views do not confirm the extrinsic "
                 "(statistics: cross_links_agreeing of cross_links_attempted)");
+  phase_done(3);
   d::build_graph(s, extrinsic, options, st);
+  phase_done(4);
   if (const RefineStatus status = d::solve_passes(s, options, result); status != RefineStatus::ok)
     return fail(status, result.reason);
+  phase_done(5);
   if (options.sequence.enabled && !d::sequence_step(s, options, result))
     return fail(RefineStatus::sequence_failed, result.reason);
   d::output_poses(s, result);

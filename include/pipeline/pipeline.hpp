@@ -46,7 +46,7 @@
 //     registration) is judged; a direction it leaves free makes the status degenerate, over
 //     ok or a stage's failure, and `unobservable` names it.
 //   - Progress: options.progress(stage, fraction in [0, 1]) on the calling thread; stages
-//     "terra", "jeep", "odometry", "hots" (HOTS reports only 0 and 1); a later hypothesis's
+//     "terra", "jeep", "odometry", "hots" (HOTS after each of its six phases); a later hypothesis's
 //     stages carry " (hypothesis k)".
 //   - Threads: every stage is deterministic for any thread count, so is this.
 //     CalibrateOptions::threads runs the call in a tbb::task_arena of that size.
