@@ -48,7 +48,7 @@ struct OdometryResult {
 
 /// The median condition of the registered steps (OdometryStep::condition: the weakest direction's
 /// share of the strongest in the scaled registration problem); 0 when none registered. In a
-/// tunnel or on a straight road with rails it is about 0.003-0.011, on the other simulated drives
+/// tunnel or on a straight road with rails it is about 0.003-0.014, on the other simulated drives
 /// 0.067-0.20 (docs/experiments/degenerate_scenes.md): the odometry then follows its motion
 /// model along the free direction, and motion-derived quantities inherit that.
 inline double median_condition(const OdometryResult& odo) {
