@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Simulate a rig, calibrate it with no initial guess, and show the clouds before and after.
 
-  PYTHONPATH=build/python python3 examples/python/calibrate_rig.py [--scenario 64-horizon]
+  PYTHONPATH=build/python /usr/bin/python3 examples/python/calibrate_rig.py [--scenario 64-horizon]
 
 Prints the extrinsic found next to the simulator's truth. With Open3D (Debian's python3-open3d)
 and a display, it opens two windows: the base's first frame (grey) with the target's placed by

@@ -44,6 +44,23 @@ Isometry3d disturbed(const Isometry3d& truth) {
   return g;
 }
 
+/// A short drive of `scenario` (seed 1, decimated 4x: enough for HOTS, quick to simulate).
+ulc::sim::Dataset short_drive(const std::string& scenario, double seconds) {
+  ulc::sim::SimulationOptions so;
+  so.seconds = seconds;
+  so.seed = 1;
+  so.decimation = 4;
+  return ulc::sim::simulate(*ulc::sim::scenario(scenario), so).dataset;
+}
+
+/// JEEP and HOTS from the disturbed truth of the drive's first pair.
+ulc::CalibrateOptions jeep_and_hots(const ulc::sim::Dataset& d) {
+  ulc::CalibrateOptions o;
+  o.stages = {Stage::jeep, Stage::hots};
+  o.initial = disturbed(d.pairs[0].T_base_target);
+  return o;
+}
+
 ulc::PairCalibration jeep_on(const ulc::sim::Dataset& d) {
   const auto& a = d.lidars[0];
   const auto& b = d.lidars[1];
@@ -128,17 +145,11 @@ TEST_CASE("a town snapshot pins every direction: JEEP's result stays ok",
 
 TEST_CASE("a 5 s highway drive through JEEP and HOTS ends degenerate along the road",
           "[calibrate][degenerate][hots]") {
-  ulc::sim::SimulationOptions so;
-  so.seconds = 5.0;
-  so.seed = 1;
-  so.decimation = 4;
-  const ulc::sim::Dataset d = ulc::sim::simulate(*ulc::sim::scenario("highway"), so).dataset;
+  const ulc::sim::Dataset d = short_drive("highway", 5.0);
   const auto& a = d.lidars[0];
   const auto& b = d.lidars[1];
-  ulc::CalibrateOptions o;
-  o.stages = {Stage::jeep, Stage::hots};
-  o.initial = disturbed(d.pairs[0].T_base_target);
-  const auto c = ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, o);
+  const auto c =
+      ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, jeep_and_hots(d));
   INFO(ulc::to_string(c.status) << ": " << c.reason);
   CHECK_FALSE(c.success);
   REQUIRE(c.status == CalibrateStatus::degenerate);
@@ -153,16 +164,10 @@ TEST_CASE("in the tunnel HOTS's answer is not used: the odometry did not see the
   // (StageTuning::min_odometry_condition): the two LiDARs' trajectories lag each other there
   // and the submaps are misplaced along it, so neither an estimated clock offset nor, with the
   // clocks given, the extrinsic along the tunnel can be vouched for.
-  ulc::sim::SimulationOptions so;
-  so.seconds = 6.0;
-  so.seed = 1;
-  so.decimation = 4;
-  const ulc::sim::Dataset d = ulc::sim::simulate(*ulc::sim::scenario("tunnel"), so).dataset;
+  const ulc::sim::Dataset d = short_drive("tunnel", 6.0);
   const auto& a = d.lidars[0];
   const auto& b = d.lidars[1];
-  ulc::CalibrateOptions o;
-  o.stages = {Stage::jeep, Stage::hots};
-  o.initial = disturbed(d.pairs[0].T_base_target);
+  ulc::CalibrateOptions o = jeep_and_hots(d);
   for (const bool clocks_given : {false, true}) {
     if (clocks_given) o.time_offset_s = 0.0;
     const auto c = ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, o);
