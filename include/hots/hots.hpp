@@ -38,7 +38,7 @@
 //     started from the time synchronisation's mean (eq:mean) and offset (without
 //     synchronisation: the graph's C and time_offset_s); with that step disabled, its start.
 //     statistics keep the graph's and the synchronisation's answers. covariance_6x6 ([rho; phi],
-//     left, base frame; m, rad) = the whole-sequence step's sandwich covariance of C
+//     left, base frame; m, rad) = the whole-sequence step's jackknife covariance of C
 //     (sequence_extrinsic.hpp) plus delta delta^T, delta = log(C_start C^-1) the step's move from
 //     the graph's or the synchronisation's C: two models of the same data, whose disagreement is
 //     the one sample the result has of an error every frame shares (refine_steps.hpp,

@@ -455,7 +455,7 @@ bool sequence_step(RefineState<S>& s, const RefineOptions& options, RefineResult
   result.extrinsic = st.sequence.extrinsic;
   result.time_offset_s = st.sequence.time_offset_s;
   if (st.sequence.has_covariance) {
-    // The sandwich sees errors that differ between frames; an error every frame shares (a
+    // The frame jackknife sees errors that differ between frames; an error every frame shares (a
     // trajectory bias, a modelling error of the whole scene) is invisible to it. The step's
     // move from the graph's (or synchronisation's) C, a second model of the same data, is one
     // sample of that disagreement: added as a rank-one term (hots.hpp).
