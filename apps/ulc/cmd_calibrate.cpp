@@ -16,12 +16,14 @@
 #include "calibration_report.hpp"
 #include "command_line.hpp"
 #include "commands.hpp"
+#include "drive_selection.hpp"
 #include "fused_cloud.hpp"
 #include "initial_extrinsic.hpp"
 #include "lidar_input.hpp"
 #include "pipeline/calibrate.hpp"
 #include "pipeline/rig.hpp"
 #include "progress.hpp"
+#include "ulc/io/io_error.hpp"
 #include "ulc/io/result_entry.hpp"
 #include "ulc/io/result_file.hpp"
 #include "ulc/io/result_yaml.hpp"
@@ -41,7 +43,7 @@ class StageProgress {
       stage_ = stage;
       bar_ = std::make_unique<Progress>(stage, quiet_);
     }
-    bar_->update(static_cast<std::size_t>(fraction * 100.0 + 0.5), 100);
+    bar_->update_fraction(fraction);
   }
 
  private:
@@ -80,8 +82,10 @@ std::vector<Stage> cycle_stages(const std::vector<Stage>& stages) {
 
 /// The result-file entry of one target of the rig: its calibration, and for a routed target
 /// the LiDAR it went through and why the direct attempt failed.
-io::PairResult rig_entry(const RigTarget& t, const std::string& base, std::size_t frame_index) {
+io::PairResult rig_entry(const RigTarget& t, const std::string& base, std::size_t frame_index,
+                         const std::optional<Selection>& selection, double budget) {
   io::PairResult r = io::to_pair_result(t.result, base, t.name);
+  if (selection) r.stages["selection"] = selection_json(*selection, budget);
   if (r.stages.contains("terra")) r.stages["terra"]["frame_index"] = frame_index;
   if (t.routed()) {
     r.via = t.via_name;
@@ -116,6 +120,10 @@ void print_summary(const io::PairResult& r) {
           "(stages.terra.hypotheses)\n",
           tried->size(), terra->at("hypothesis_used").get<double>() + 1.0);
   }
+  if (const io::Json* s = io::find_member(r.stages, "selection"); s && s->at("applied").get<bool>())
+    std::printf("  stretch %.0f-%.0f s of the %.0f s drive (stages.selection)\n",
+                s->at("start_s").get<double>(), s->at("end_s").get<double>(),
+                s->at("drive_s").get<double>());
   for (const auto& d : r.unobservable) std::printf("  free    %s\n", d.words.c_str());
   const Eigen::Vector3d t = r.T_base_target.translation();
   const Eigen::Vector3d rpy = ulc::rpy_from_rotation(r.T_base_target.linear()) * kDeg;
@@ -164,6 +172,7 @@ struct CalibrateArgs {
   // Set when the user gave them.
   CLI::Option *output_option = nullptr, *merged_option = nullptr, *report_option = nullptr,
               *initial_option = nullptr, *threads_option = nullptr;
+  double budget = SelectionOptions{}.budget_s;  ///< --budget
   double time_offset = 0.0;  ///< --time-offset: a known offset of every target's clock
   CLI::Option* time_offset_option = nullptr;
 
@@ -182,6 +191,12 @@ void add_source_options(CLI::App& app, CalibrateArgs& a) {
       ->required()
       ->allow_extra_args(false);
   add_input_options(app, a.input);
+  app.add_option("--budget", a.budget,
+                 "seconds of data HOTS calibrates on: a longer drive is surveyed and its best "
+                 "stretch of S seconds used (stages.selection says which and why); 0: the whole "
+                 "drive; --start / --duration choose the stretch yourself (default 60)")
+      ->type_name("S")
+      ->check(CLI::Range(0.0, 1e9));
 }
 
 void add_output_options(CLI::App& app, CalibrateArgs& a) {
@@ -265,12 +280,13 @@ CalibrateOptions calibrate_options(const CalibrateArgs& a) {
   return options;
 }
 
-/// Every LiDAR's frames from frame_index, as many as the stages need, held for the whole rig
-/// (routes and cycles pair targets too); the base's are shared by all targets.
+/// Every LiDAR's frames from frame_index, as many as the stages need, read on demand for the
+/// whole rig (routes and cycles pair targets too); the base's are shared by all targets.
 struct LoadedRig {
+  std::optional<Selection> selection;  ///< when the drive was surveyed
   std::vector<std::unique_ptr<LidarInput>> inputs;
-  std::vector<LoadedFrames> frames;  ///< the base's first
-  std::vector<RigLidar<std::vector<PointCloud<float>>>> lidars;
+  std::vector<StreamedFrames> frames;  ///< the base's first
+  std::vector<RigLidar<FrameSource>> lidars;
 };
 
 LoadedRig load_rig(const CalibrateArgs& a, const CalibrateOptions& options) {
@@ -280,8 +296,21 @@ LoadedRig load_rig(const CalibrateArgs& a, const CalibrateOptions& options) {
   std::vector<LidarSpec> specs{parse_lidar_spec(a.base_spec, "calibrate", "base")};
   for (const auto& t : a.target_specs) specs.push_back(parse_lidar_spec(t, "calibrate", "target"));
   LoadedRig rig;
-  rig.inputs = open_lidar_inputs(specs, input_options(a.input, "calibrate"), "calibrate");
+  InputOptions input = input_options(a.input, "calibrate");
+  rig.inputs = open_lidar_inputs(specs, input, "calibrate");
   print_input_warnings(rig.inputs, "calibrate");
+  // A drive longer than the budget: HOTS gets the best stretch of it (pipeline/selection.hpp).
+  const bool user_window = input.window.start_s || input.window.duration_s;
+  if (run_hots && a.budget > 0.0 && !user_window && rig.inputs.front()->span_s() > a.budget) {
+    SelectionOptions so;
+    so.budget_s = a.budget;
+    rig.selection = survey_drive(*rig.inputs.front(), so, a.quiet);
+    if (rig.selection->applied) {
+      input.window.start_s = rig.selection->start_s;
+      input.window.duration_s = a.budget;
+      rig.inputs = open_lidar_inputs(specs, input, "calibrate");
+    }
+  }
   const LidarInput& base = *rig.inputs.front();
   const std::size_t base_count = run_hots   ? kAllFrames
                                  : run_jeep ? jeep_only_count(options, base.period())
@@ -291,12 +320,12 @@ LoadedRig load_rig(const CalibrateArgs& a, const CalibrateOptions& options) {
     const std::size_t count = k == 0 || run_hots ? base_count
                               : run_jeep ? covering_count(base.period(), lidar.period(), base_count)
                                          : 1;
-    rig.frames.push_back(lidar.load(frame_index, count));
+    rig.frames.push_back(lidar.stream(frame_index, count));
     require_frame(lidar, rig.frames.back(), frame_index);
   }
   for (std::size_t k = 0; k < rig.inputs.size(); ++k) {
-    RigLidar<std::vector<PointCloud<float>>> l{
-        rig.inputs[k]->name(), &rig.frames[k].clouds, &rig.frames[k].times, {}};
+    RigLidar<FrameSource> l{
+        rig.inputs[k]->name(), rig.frames[k].frames.get(), &rig.frames[k].times, {}};
     if (k > 0 && !has_stage(options.stages, Stage::terra))
       l.initial = parse_initial(a.initial, base.name(), l.name);
     rig.lidars.push_back(std::move(l));
@@ -320,6 +349,10 @@ RigCalibration run_rig(const CalibrateArgs& a, const CalibrateOptions& options,
   std::optional<tbb::task_arena> arena;
   if (a.has(a.threads_option)) arena.emplace(static_cast<int>(a.threads));
   RigCalibration rig = arena ? arena->execute(run) : run();
+  // A frame that could not be read reached the stages empty: the result is not to be trusted.
+  for (std::size_t k = 0; k < loaded.frames.size(); ++k)
+    if (const std::string why = loaded.frames[k].frames->error(); !why.empty())
+      throw io::IoError(loaded.inputs[k]->source(), "", "a frame could not be read: " + why);
   if (rig.status == RigStatus::invalid_input) throw UsageError("calibrate: " + rig.reason);
   return rig;
 }
@@ -336,17 +369,18 @@ struct RigOutputs {
 RigOutputs rig_outputs(const CalibrateArgs& a, const LoadedRig& loaded, const RigCalibration& rig) {
   const std::string& base = loaded.lidars.front().name;
   RigOutputs out;
-  out.fused.push_back({points_of(loaded.frames.front().clouds.front()), Isometry3d::Identity()});
+  out.fused.push_back({points_of(loaded.frames.front().frames->load(0)), Isometry3d::Identity()});
   out.report.push_back(
       {base, out.fused.front().points, Isometry3d::Identity(), Isometry3d::Identity()});
   const bool pictures = a.has(a.merged_option) || a.has(a.report_option);
   for (const RigTarget& t : rig.targets) {
-    out.results.push_back(rig_entry(t, base, static_cast<std::size_t>(a.frame_index)));
+    out.results.push_back(
+        rig_entry(t, base, static_cast<std::size_t>(a.frame_index), loaded.selection, a.budget));
     print_summary(out.results.back());
     if (!pictures) continue;
     const Isometry3d before = loaded.lidars[t.lidar].initial.value_or(Isometry3d::Identity());
     const Isometry3d after = t.ok() ? t.result.T_base_target : before;
-    out.fused.push_back({points_of(loaded.frames[t.lidar].clouds.front()), after});
+    out.fused.push_back({points_of(loaded.frames[t.lidar].frames->load(0)), after});
     out.report.push_back({t.name, out.fused.back().points, before, after});
   }
   for (const RigCycle& c : rig.cycles) {
