@@ -280,6 +280,14 @@ CalibrateOptions calibrate_options(const CalibrateArgs& a) {
   return options;
 }
 
+/// f() run with --threads worker threads when given (else TBB's default).
+template <class F>
+auto in_arena(const CalibrateArgs& a, const F& f) {
+  if (!a.has(a.threads_option)) return f();
+  tbb::task_arena arena(static_cast<int>(a.threads));
+  return arena.execute(f);
+}
+
 /// Every LiDAR's frames from frame_index, as many as the stages need, read on demand for the
 /// whole rig (routes and cycles pair targets too); the base's are shared by all targets.
 struct LoadedRig {
@@ -304,7 +312,7 @@ LoadedRig load_rig(const CalibrateArgs& a, const CalibrateOptions& options) {
   if (run_hots && a.budget > 0.0 && !user_window && rig.inputs.front()->span_s() > a.budget) {
     SelectionOptions so;
     so.budget_s = a.budget;
-    rig.selection = survey_drive(*rig.inputs.front(), so, a.quiet);
+    rig.selection = in_arena(a, [&] { return survey_drive(*rig.inputs.front(), so, a.quiet); });
     if (rig.selection->applied) {
       input.window.start_s = rig.selection->start_s;
       input.window.duration_s = a.budget;
@@ -345,10 +353,7 @@ RigCalibration run_rig(const CalibrateArgs& a, const CalibrateOptions& options,
   rig_options.pair.progress = [&progress](const std::string& stage, double f) {
     progress(stage, f);
   };
-  auto run = [&] { return calibrate_rig(loaded.lidars, 0, rig_options); };
-  std::optional<tbb::task_arena> arena;
-  if (a.has(a.threads_option)) arena.emplace(static_cast<int>(a.threads));
-  RigCalibration rig = arena ? arena->execute(run) : run();
+  RigCalibration rig = in_arena(a, [&] { return calibrate_rig(loaded.lidars, 0, rig_options); });
   // A frame that could not be read reached the stages empty: the result is not to be trusted.
   for (std::size_t k = 0; k < loaded.frames.size(); ++k)
     if (const std::string why = loaded.frames[k].frames->error(); !why.empty())

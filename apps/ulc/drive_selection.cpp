@@ -31,7 +31,9 @@ Selection survey_drive(const LidarInput& base, const SelectionOptions& options, 
       return true;
     });
   }
-  return survey.select(first, last);
+  Selection s = survey.select(first, last);
+  s.seconds = progress.elapsed();
+  return s;
 }
 
 io::Json selection_json(const Selection& s, double budget_s) {
@@ -42,6 +44,7 @@ io::Json selection_json(const Selection& s, double budget_s) {
   j["start_s"] = s.start_s;
   j["end_s"] = s.end_s;
   j["why"] = s.why;
+  j["seconds"] = s.seconds;
   io::Json windows = io::Json::array();
   for (const StretchScore& w : s.windows) {
     io::Json e = io::Json::object();

@@ -82,6 +82,7 @@ struct Selection {
   std::size_t chosen = 0;             ///< index into windows
   std::vector<StretchScore> windows;
   std::string why;
+  double seconds = 0.0;  ///< the survey's time (set by the caller that timed it)
 };
 
 /// The survey of one drive: frames in, one at a time in time order (see the top).
