@@ -75,7 +75,7 @@
 namespace hots {
 
 /// The share of refine done after each of its phases, for a progress bar: the phases' shares of
-/// HOTS's time on the 60 s 64-32 drive (docs/BENCHMARKS.md, "Long drives": prepare 6 %, hierarchy
+/// HOTS's time on the 60 s 64-32 drive (docs/experiments/long_drives.md: prepare 6 %, hierarchy
 /// 35 %, cross links 27 %, graph and synchronisation 1 %, whole-sequence step 31 %).
 using RefineProgress = std::function<void(double share)>;
 

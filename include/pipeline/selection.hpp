@@ -44,8 +44,8 @@ namespace ulc {
 
 struct SelectionOptions {
   /// s of data calibrated on a longer drive; <= 0: the whole drive. 60 s: the drive length
-  /// whose accuracy docs/BENCHMARKS.md holds (64-32: e_rot 0.003 deg, e_trans 0.1 cm) at
-  /// 1.4 GB peak and about a minute on 2 cores ("Long drives").
+  /// whose accuracy docs/BENCHMARKS.md holds (64-32: e_rot 0.0025 deg, e_trans 0.1 cm, offset
+  /// exact) at a 1.3 GB peak ("Long drives"); memory grows with it (HOTS keeps its frames).
   double budget_s = 60.0;
   double step_s = 5.0;  ///< s between the starts of candidate stretches
   /// Base frames per second the survey registers: 2 Hz (5 m apart at 10 m/s, within the
