@@ -17,12 +17,15 @@
 // runs (ulc/core/observability.hpp: below max_share = 0.01 a direction is free), which is how
 // the threshold was chosen (docs/experiments/degenerate_scenes.md). fixed_cm is the largest
 // translation error of a degenerate result with its free translation directions projected
-// out: what the result still says about the other directions. --per-run prints every run.
+// out: what the result still says about the other directions. --per-run prints every run;
+// --results DIR writes each run's result file (DIR/<scenario>_<seconds>s_seed<N>.json, the
+// command's format) to see why a run ended as it did.
 #include <tbb/task_arena.h>
 #include <algorithm>
 #include <cstdlib>
 #include <iostream>
 #include <map>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -31,6 +34,7 @@
 #include "support/bench_util.hpp"
 #include "ulc/core/observability.hpp"
 #include "ulc/core/pose_error.hpp"
+#include "ulc/io/result_entry.hpp"
 
 namespace {
 
@@ -50,6 +54,7 @@ struct Config {
   std::size_t first_run = 0;
   int threads = 2;
   bool per_run = false;
+  std::string results_dir;  ///< empty: no result files
   ulc_bench::Options bench;
 };
 
@@ -134,6 +139,17 @@ void count(const ulc::PairCalibration& r, const ulc::PoseError& e, const Isometr
   }
 }
 
+/// The run's result file, as `ulc calibrate --output` writes it.
+void write_result(const Config& c, const Drive& drive, std::size_t run, const ulc::sim::Dataset& d,
+                  const ulc::PairCalibration& r) {
+  if (c.results_dir.empty()) return;
+  std::ostringstream name;
+  name << c.results_dir << "/" << drive.scenario << "_" << drive.seconds << "s_seed" << run + 1
+       << ".json";
+  ulc::io::write_result_file(name.str(),
+                             {ulc::io::to_pair_result(r, d.lidars[0].name, d.lidars[1].name)});
+}
+
 void bench(const Config& c) {
   ulc_bench::Table runs({"drive", "seed", "status", "e_rot_deg", "e_trans_cm", "fixed_cm",
                          "problem", "weakest_share", "free"});
@@ -157,6 +173,7 @@ void bench(const Config& c) {
           ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, o);
       const ulc::PoseError e = ulc::pose_error(truth, r.T_base_target);
       count(r, e, truth, t);
+      write_result(c, drive, run, d, r);
       std::string free;
       for (const auto& dir : r.unobservable)
         free += (free.empty() ? "" : "; ") + short_words(dir.words);
@@ -213,6 +230,9 @@ int main(int argc, char** argv) {
   ulc_bench::add_first_run_option(app, c.first_run);
   ulc_bench::add_threads_option(app, c.threads);
   app.add_flag("--per-run", c.per_run, "print every run's row before the summary");
+  app.add_option("--results", c.results_dir, "write each run's result file into this folder")
+      ->type_name("DIR")
+      ->check(CLI::ExistingDirectory);
   CLI11_PARSE(app, argc, argv);
   bench(c);
   return 0;

@@ -44,14 +44,16 @@
 //     (docs/experiments/time_offset_drive_length.md). A distrusted
 //     offset is reported (time_offset_trusted, time_offset_doubt); it does not change C or dt.
 //   - Extrinsic covariance (covariance_6x6, [rho; phi] of C <- exp(xi) C: base frame, m and rad)
-//     from the final problem at the answer, by the M-estimator sandwich A^-1 M A^-1
-//     (ulc/core/cluster_covariance.hpp): A = sum psi'(r) J J^T, the robust cost's curvature
-//     (kernel.curvature: the Geman-McClure kernel of the fine stage turns residuals beyond
-//     scale / sqrt(3) away, so A is several times smaller than the IRLS normal matrix sum w J J^T,
-//     whose inverse is 3-10x too small in sigma on the simulated drives), and M the outer products
-//     of the gradients sum w r J of each target frame (one frame's points share its placement
-//     error: per-point clustering is another 2-4x too small). With dt solved alongside C it is
-//     the 7x7 sandwich's 6x6 block, so dt's uncertainty widens C's.
+//     from the final problem at the answer, by the M-estimator's delete-one-frame jackknife
+//     (ulc/core/cluster_covariance.hpp, CR3): sum over target frames c of d_c d_c^T, d_c =
+//     (A - A_c)^-1 g_c the estimate's change without frame c, with A = sum psi'(r) J J^T the
+//     robust cost's curvature (kernel.curvature: the Geman-McClure kernel of the fine stage
+//     turns residuals beyond scale / sqrt(3) away, so A is several times smaller than the IRLS
+//     normal matrix sum w J J^T, whose inverse is 3-10x too small in sigma on the simulated
+//     drives) and g_c the frame's gradient sum w r J (one frame's points share its placement
+//     error: per-point clustering is another 2-4x too small; about 25 frames of a 10 s drive
+//     give each a leverage the plain sandwich A^-1 M A^-1 ignores). With dt solved alongside C
+//     it is the 7x7 jackknife's 6x6 block, so dt's uncertainty widens C's.
 //     Measured in docs/experiments/covariance_coverage.md.
 //   - The result keeps C and dt of the input when the registration fails (status says why).
 //   - Nothing here throws or prints; the same results for any number of threads (per-term
@@ -565,31 +567,26 @@ void check_offset(SequenceProblem<S>& problem, const Solve& s, double dt0,
 }
 
 /// The covariance of C from the final problem at the solve's answer (see extrinsic covariance
-/// in the header comment): the M-estimator sandwich A^-1 M A^-1 with A = sum psi'(r) J J^T and
-/// the gradients w r J clustered by target frame. With dt solved alongside C (7 parameters) it
-/// is the 7x7 sandwich's 6x6 block (C's marginal); with dt held, the 6x6 problem's. Empty when
-/// A is singular or fewer than two frames matched.
+/// in the header comment): the delete-one-frame jackknife of the M-estimator
+/// (ulc/core/cluster_covariance.hpp), with each point's curvature psi'(r) J J^T and gradient
+/// w r J clustered by target frame. With dt solved alongside C (7 parameters) it is the 7x7
+/// jackknife's 6x6 block (C's marginal); with dt held, the 6x6 problem's. Empty when fewer than
+/// two frames matched or leaving one frame out makes the problem singular.
 template <typename S>
 std::optional<Mat6d> extrinsic_covariance(SequenceProblem<S>& problem, const Solve& s,
                                           bool with_time, const SequenceExtrinsicOptions& o) {
   const ulc::RegistrationOptions& stage = o.stages.back();
   problem.set_stage(stage, with_time);
   problem.match({s.C, s.dt});
-  Mat7 A = Mat7::Zero();
-  ulc::ClusterGradients<7, std::size_t> frames;
+  ulc::ClusterJackknife<7, std::size_t> frames;
   problem.visit_points(s.C, [&](std::size_t frame, const Vec7& J, double r) {
-    A.noalias() += stage.kernel.curvature(r) * J * J.transpose();
-    frames.add(frame, Vec7((stage.kernel.weight(r) * r) * J));
+    frames.add(frame, Mat7(stage.kernel.curvature(r) * J * J.transpose()),
+               Vec7((stage.kernel.weight(r) * r) * J));
   });
-  if (frames.clusters() < 2) return std::nullopt;
-  const Mat7 M = frames.meat();
-  if (with_time) {
-    const auto c = ulc::sandwich_covariance<7>(A, M);
-    if (!c) return std::nullopt;
-    return Mat6d(c->topLeftCorner<6, 6>());
-  }
-  return ulc::sandwich_covariance<6>(Mat6d(A.topLeftCorner<6, 6>()),
-                                     Mat6d(M.topLeftCorner<6, 6>()));
+  if (!with_time) return frames.covariance<6>();
+  const auto c = frames.covariance<7>();
+  if (!c) return std::nullopt;
+  return Mat6d(c->topLeftCorner<6, 6>());
 }
 
 /// The solve's answer and statistics into the result.

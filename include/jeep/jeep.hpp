@@ -21,7 +21,7 @@
 //   - Acceptance (status rejected otherwise), see acceptance.hpp.
 //   - covariance_6x6: of the final C ([rho; phi], left: C <- exp(xi) C, base frame, m and rad)
 //     from the last round's calibration problem at that C: map b at the last stage's source
-//     voxel against map a's planes, the cluster-robust sandwich with the points in one
+//     voxel against map a's planes, the delete-one-cluster jackknife with the points in one
 //     covariance_cell-sized cell of map a as a cluster (ulc/core/registration_covariance.hpp:
 //     the robust kernel's curvature as the bread), plus delta delta^T with delta the two-way
 //     step's move from the forward registration's answer (two models of the same maps; one

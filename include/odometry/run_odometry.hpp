@@ -46,6 +46,21 @@ struct OdometryResult {
   bool ok() const { return status == OdometryStatus::ok; }
 };
 
+/// The median condition of the registered steps (OdometryStep::condition: the weakest direction's
+/// share of the strongest in the scaled registration problem); 0 when none registered. In a
+/// tunnel or on a straight road with rails it is about 0.003-0.011, on the other simulated drives
+/// 0.067-0.20 (docs/experiments/degenerate_scenes.md): the odometry then follows its motion
+/// model along the free direction, and motion-derived quantities inherit that.
+inline double median_condition(const OdometryResult& odo) {
+  std::vector<double> c;
+  for (const OdometryStep& s : odo.steps)
+    if (s.registered) c.push_back(s.condition);
+  if (c.empty()) return 0.0;
+  const auto middle = c.begin() + static_cast<std::ptrdiff_t>(c.size() / 2);
+  std::nth_element(c.begin(), middle, c.end());
+  return *middle;
+}
+
 using ProgressFn = std::function<void(std::size_t done, std::size_t total)>;
 
 namespace detail {

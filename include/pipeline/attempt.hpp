@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstddef>
+#include <cstdio>
 #include <optional>
 #include <string>
 #include <utility>
@@ -197,6 +198,7 @@ inline HotsReport odometry_report(const odometry::OdometryResult& odo, const Iso
   h.frames_base = odo.poses_a.size();
   h.frames_target = odo.poses_b.size();
   h.odometry_failed_steps = odo.failed_steps;
+  h.odometry_condition = odometry::median_condition(odo);
   h.initial = initial;
   h.extrinsic = initial;
   h.odometry_seconds = odometry_seconds;
@@ -228,6 +230,24 @@ inline std::string hots_failure(const hots::RefineResult& h) {
         "; a longer drive with turns and speed changes pins it down, and synchronised clocks "
         "are said so with time_offset_s = 0 (ulc calibrate --synced-clocks)";
   return why;
+}
+
+/// Why HOTS's estimated clock offset cannot be trusted although HOTS's own checks passed: the
+/// odometry it was synchronised on did not see the motion (StageTuning::min_odometry_condition);
+/// empty when it can be, or when the offset was given.
+template <class FA, class FB>
+std::string odometry_offset_doubt(const AttemptInputs<FA, FB>& in, const HotsReport& h) {
+  if (!in.hots.synchronise_time || h.odometry_condition >= in.options.tuning.min_odometry_condition)
+    return "";
+  char text[96];
+  std::snprintf(text, sizeof(text), "%.4f (at least %.4f needed)", h.odometry_condition,
+                in.options.tuning.min_odometry_condition);
+  return std::string(
+             "the odometry's registrations leave a direction nearly free (median "
+             "condition ") +
+         text +
+         ": a tunnel or a straight road), so the motion the clock offset was synchronised on "
+         "is not observed along it";
 }
 
 /// The odometry over every frame, then hots::refine on its poses.
@@ -262,6 +282,15 @@ StageOutcome hots_step(const AttemptInputs<FA, FB>& in, Attempt& at) {
     return failed_after_jeep(
         at, CalibrateStatus::hots_failed, hots_failure(h),
         h.status == hots::RefineStatus::extrinsic_unconfirmed || !at.jeep_failure.empty());
+  if (std::string doubt = odometry_offset_doubt(in, *at.out.hots); !doubt.empty()) {
+    at.out.hots->status = hots::RefineStatus::time_offset_untrusted;
+    at.out.hots->reason = doubt;
+    return failed_after_jeep(at, CalibrateStatus::hots_failed,
+                             "HOTS: time_offset_untrusted: " + doubt +
+                                 "; synchronised clocks are said so with time_offset_s = 0 (ulc "
+                                 "calibrate --synced-clocks)",
+                             !at.jeep_failure.empty());
+  }
   notify(in.options, hots_stage, 1.0);
   at.out.T_base_target = h.extrinsic;
   at.out.time_offset_s += h.time_offset_s;

@@ -166,6 +166,7 @@ struct HotsReport {
   std::string odometry_reason;
   std::size_t frames_base = 0, frames_target = 0;  ///< frames given to odometry and HOTS
   std::size_t odometry_failed_steps = 0;
+  double odometry_condition = 0.0;  ///< odometry::median_condition of the odometry's steps
   Isometry3d initial = Isometry3d::Identity();    ///< the extrinsic HOTS started from
   Isometry3d extrinsic = Isometry3d::Identity();  ///< HOTS's extrinsic (even if failed)
   double time_offset_s = 0.0;                     ///< t_base_clock = t_target_clock + offset

@@ -118,3 +118,67 @@ TEST_CASE("cluster covariance: a shared error per cluster widens the sandwich by
   CHECK((*clustered)(0, 0) == Approx(1.0 / n).epsilon(0.15));
   CHECK((*clustered)(0, 0) / (*independent)(0, 0) == Approx(m).epsilon(0.01));
 }
+
+TEST_CASE(
+    "cluster jackknife: for linear least squares it is the spread of the delete-one-cluster "
+    "refits",
+    "[registration][covariance]") {
+  // y = X b + e with 8 clusters of 5 rows sharing part of their error. For a linear problem the
+  // one-step change d_c = (A - A_c)^-1 g_c is the exact change of the estimate when cluster c
+  // is left out and the rest refitted, so the jackknife must equal (G - 1) / G times the sum of
+  // the refits' outer products (CR3), which is computed here by refitting.
+  constexpr int kClusters = 8, kRows = 5;
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  using Mat3 = Eigen::Matrix3d;
+  using Vec3 = Eigen::Vector3d;
+  std::vector<Vec3> x;
+  std::vector<double> y;
+  std::vector<int> cluster;
+  for (int c = 0; c < kClusters; ++c) {
+    const double shared = gauss(rng);
+    for (int k = 0; k < kRows; ++k) {
+      x.emplace_back(1.0, gauss(rng), gauss(rng));
+      y.push_back(x.back().dot(Vec3(0.5, -1.0, 2.0)) + shared + 0.3 * gauss(rng));
+      cluster.push_back(c);
+    }
+  }
+  const auto fit = [&](int left_out) {
+    Mat3 A = Mat3::Zero();
+    Vec3 b = Vec3::Zero();
+    for (std::size_t i = 0; i < x.size(); ++i)
+      if (cluster[i] != left_out) {
+        A += x[i] * x[i].transpose();
+        b += x[i] * y[i];
+      }
+    return Vec3(A.ldlt().solve(b));
+  };
+  const Vec3 all = fit(-1);
+  ulc::ClusterJackknife<3> jackknife;
+  for (std::size_t i = 0; i < x.size(); ++i)  // r = x . b - y, J = x, w = 1, psi' = 1
+    jackknife.add(cluster[i], x[i] * x[i].transpose(), x[i] * (x[i].dot(all) - y[i]));
+  Mat3 refits = Mat3::Zero();
+  for (int c = 0; c < kClusters; ++c) {
+    const Vec3 d = fit(c) - all;
+    refits += d * d.transpose();
+  }
+  refits *= (kClusters - 1.0) / kClusters;
+  const auto cov = jackknife.covariance();
+  REQUIRE(cov);
+  CHECK((*cov - refits).norm() <= 1e-9 * refits.norm());
+  // The held problem (the leading two parameters, the third fixed at zero) is the jackknife of
+  // that smaller problem's blocks: finite and positive definite.
+  const auto held = jackknife.covariance<2>();
+  REQUIRE(held);
+  CHECK(held->determinant() > 0.0);
+  // The jackknife is at least the plain sandwich here: every cluster has leverage.
+  ulc::ClusterGradients<3> gradients;
+  Mat3 A = Mat3::Zero();
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    gradients.add(cluster[i], x[i] * (x[i].dot(all) - y[i]));
+    A += x[i] * x[i].transpose();
+  }
+  const auto sandwich = ulc::sandwich_covariance<3>(A, gradients.meat());
+  REQUIRE(sandwich);
+  CHECK(cov->trace() > sandwich->trace());
+}

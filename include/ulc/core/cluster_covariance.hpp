@@ -12,6 +12,15 @@
 // cluster; treating them as independent would be optimistic by the square root of the cluster
 // size.
 //
+// With few clusters (a 10 s drive has about 25 target frames for 6-7 parameters) the sandwich
+// is too small: each cluster's gradient is measured at an estimate it helped to fit (a leverage
+// of about N / G each). The delete-one-cluster jackknife (CR3, Cameron and Miller section VI.B;
+// MacKinnon and White 1985) removes that: with A = sum of every residual's curvature and A_c
+// the share of cluster c,
+//   cov(x) = (G - 1) / G * sum_c d_c d_c^T,   d_c = (A - A_c)^-1 g_c,
+// d_c being the one-step change of the estimate when cluster c is left out
+// (ClusterJackknife; measured in docs/experiments/covariance_coverage.md).
+//
 // Conventions this header owns:
 //   - N parameters (6 for an extrinsic [rho; phi], 7 with a clock offset); H symmetric.
 //   - ClusterGradients sums per-residual gradients by an integer key, in key order (a std::map):
@@ -25,6 +34,7 @@
 #include <cstdint>
 #include <map>
 #include <optional>
+#include <utility>
 
 #include <Eigen/Core>
 #include <Eigen/LU>
@@ -56,6 +66,51 @@ class ClusterGradients {
 
  private:
   std::map<Key, Vec> sums_;
+};
+
+/// Per-cluster curvature and gradient sums for the delete-one-cluster jackknife (CR3, see the
+/// top). add(key, a, g) takes one residual's curvature a = psi'(r) J J^T and gradient
+/// g = w r J; clusters are kept in key order (std::map), so sums do not depend on threads when
+/// the caller adds sequentially.
+template <int N, class Key = std::int64_t>
+class ClusterJackknife {
+ public:
+  using Vec = Eigen::Matrix<double, N, 1>;
+  using Mat = Eigen::Matrix<double, N, N>;
+
+  void add(const Key& key, const Mat& curvature, const Vec& gradient) {
+    auto [it, fresh] = sums_.try_emplace(key, curvature, gradient);
+    if (!fresh) {
+      it->second.first += curvature;
+      it->second.second += gradient;
+    }
+  }
+  std::size_t clusters() const { return sums_.size(); }
+
+  /// The jackknife covariance of the leading M parameters (M <= N: the problem with the last
+  /// N - M parameters held); nullopt with fewer than two clusters, or when leaving one cluster
+  /// out makes the problem singular (that cluster alone pins a direction), or a non-finite result.
+  template <int M = N>
+  std::optional<Eigen::Matrix<double, M, M>> covariance() const {
+    using SubMat = Eigen::Matrix<double, M, M>;
+    const double G = static_cast<double>(sums_.size());
+    if (G < 2.0) return std::nullopt;
+    SubMat A = SubMat::Zero();
+    for (const auto& kv : sums_) A += kv.second.first.template topLeftCorner<M, M>();
+    SubMat cov = SubMat::Zero();
+    for (const auto& kv : sums_) {
+      const Eigen::FullPivLU<SubMat> lu(SubMat(A - kv.second.first.template topLeftCorner<M, M>()));
+      if (!lu.isInvertible()) return std::nullopt;
+      const Eigen::Matrix<double, M, 1> d = lu.solve(kv.second.second.template head<M>());
+      cov.noalias() += d * d.transpose();
+    }
+    cov = ((G - 1.0) / G * 0.5 * (cov + cov.transpose())).eval();
+    if (!cov.allFinite()) return std::nullopt;
+    return cov;
+  }
+
+ private:
+  std::map<Key, std::pair<Mat, Vec>> sums_;
 };
 
 /// H^-1 M H^-1, symmetrised; nullopt when H is not invertible or the result is not finite.

@@ -1,5 +1,6 @@
 // The covariance of a point-to-plane registration's pose from its final problem
-// (point_to_plane.hpp's residuals at the returned pose, cluster_covariance.hpp's sandwich).
+// (point_to_plane.hpp's residuals at the returned pose, cluster_covariance.hpp's delete-one-cluster
+// jackknife of the M-estimator: each point's curvature psi'(r) J J^T and gradient w r J).
 //
 // Conventions this header owns:
 //   - The pose T of register_point_to_plane_terms, perturbed on the left (T <- exp(xi) T,
@@ -9,8 +10,9 @@
 //   - Clusters: the source points whose matched point z (target frame) falls in one cubic cell
 //     of side cell_size share their errors (a surface the two clouds sample differently, a
 //     modelling error of one wall); cell_size 0 treats every point as its own cluster (the
-//     heteroscedasticity-robust sandwich, right for independent point noise).
-//   - nullopt when the normal matrix is not invertible or fewer than two clusters matched.
+//     delete-one-point jackknife, right for independent point noise).
+//   - nullopt when fewer than two clusters matched or leaving one out makes the problem
+//     singular.
 #pragma once
 
 #include <cstdint>
@@ -30,8 +32,7 @@ std::optional<Mat6d> point_to_plane_covariance(
     const RegistrationOptions& options, double cell_size) {
   PointToPlaneMatches matches;
   match_point_to_plane(terms, T, options.max_correspondence_distance, matches);
-  Mat6d H = Mat6d::Zero();
-  ClusterGradients<6> clusters;
+  ClusterJackknife<6> clusters;
   std::int64_t index = 0;
   Vec6d J;
   for (std::size_t t = 0; t < terms.size(); ++t) {
@@ -45,12 +46,12 @@ std::optional<Mat6d> point_to_plane_covariance(
       const Vec3d z = geometry.target_frame(y);
       const double r = geometry.residual(y, z, plane, &J);
       const double w = term.weight * options.kernel.weight(r);
-      H.noalias() += term.weight * options.kernel.curvature(r) * J * J.transpose();
-      clusters.add(cell_size > 0.0 ? cell_key(z, cell_size) : index, Vec6d((w * r) * J));
+      clusters.add(cell_size > 0.0 ? cell_key(z, cell_size) : index,
+                   Mat6d(term.weight * options.kernel.curvature(r) * J * J.transpose()),
+                   Vec6d((w * r) * J));
     }
   }
-  if (clusters.clusters() < 2) return std::nullopt;
-  return sandwich_covariance<6>(H, clusters.meat());
+  return clusters.covariance();
 }
 
 /// The same for one source cloud against one target (T = T_target_source).

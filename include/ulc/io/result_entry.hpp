@@ -156,6 +156,7 @@ inline Json hots_to_json(const HotsReport& h) {
   j["odometry_status"] = h.run == HotsRun::skipped ? "" : odometry::to_string(h.odometry_status);
   j["odometry_reason"] = h.odometry_reason;
   j["odometry_failed_steps"] = h.odometry_failed_steps;
+  j["odometry_condition"] = h.odometry_condition;
   j["frames_base"] = h.frames_base;
   j["frames_target"] = h.frames_target;
   j["initial_T_base_target"] = matrix_to_json(h.initial.matrix());
