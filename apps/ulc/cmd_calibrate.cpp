@@ -297,6 +297,23 @@ struct LoadedRig {
   std::vector<RigLidar<FrameSource>> lidars;
 };
 
+/// A drive longer than the budget (by more than a frame) and no --start / --duration: the
+/// base's drive is surveyed and the inputs opened again on its best stretch
+/// (pipeline/selection.hpp).
+void choose_stretch(const CalibrateArgs& a, const std::vector<LidarSpec>& specs, InputOptions input,
+                    LoadedRig& rig) {
+  const LidarInput& base = *rig.inputs.front();
+  const bool user_window = input.window.start_s || input.window.duration_s;
+  if (!(a.budget > 0.0) || user_window || base.span_s() <= a.budget + base.period()) return;
+  SelectionOptions so;
+  so.budget_s = a.budget;
+  rig.selection = in_arena(a, [&] { return survey_drive(base, so, a.quiet); });
+  if (!rig.selection->applied) return;
+  input.window.start_s = rig.selection->start_s;
+  input.window.duration_s = a.budget;
+  rig.inputs = open_lidar_inputs(specs, input, "calibrate");
+}
+
 LoadedRig load_rig(const CalibrateArgs& a, const CalibrateOptions& options) {
   const bool run_jeep = has_stage(options.stages, Stage::jeep);
   const bool run_hots = has_stage(options.stages, Stage::hots);
@@ -304,21 +321,10 @@ LoadedRig load_rig(const CalibrateArgs& a, const CalibrateOptions& options) {
   std::vector<LidarSpec> specs{parse_lidar_spec(a.base_spec, "calibrate", "base")};
   for (const auto& t : a.target_specs) specs.push_back(parse_lidar_spec(t, "calibrate", "target"));
   LoadedRig rig;
-  InputOptions input = input_options(a.input, "calibrate");
+  const InputOptions input = input_options(a.input, "calibrate");
   rig.inputs = open_lidar_inputs(specs, input, "calibrate");
   print_input_warnings(rig.inputs, "calibrate");
-  // A drive longer than the budget: HOTS gets the best stretch of it (pipeline/selection.hpp).
-  const bool user_window = input.window.start_s || input.window.duration_s;
-  if (run_hots && a.budget > 0.0 && !user_window && rig.inputs.front()->span_s() > a.budget) {
-    SelectionOptions so;
-    so.budget_s = a.budget;
-    rig.selection = in_arena(a, [&] { return survey_drive(*rig.inputs.front(), so, a.quiet); });
-    if (rig.selection->applied) {
-      input.window.start_s = rig.selection->start_s;
-      input.window.duration_s = a.budget;
-      rig.inputs = open_lidar_inputs(specs, input, "calibrate");
-    }
-  }
+  if (run_hots) choose_stretch(a, specs, input, rig);
   const LidarInput& base = *rig.inputs.front();
   const std::size_t base_count = run_hots   ? kAllFrames
                                  : run_jeep ? jeep_only_count(options, base.period())
