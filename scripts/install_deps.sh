@@ -4,7 +4,8 @@
 set -euo pipefail
 packages=(g++ cmake ninja-build libeigen3-dev libtbb-dev libnanoflann-dev catch2 libstb-dev
   pkg-config libbz2-dev liblz4-dev libzstd-dev libsqlite3-dev
-  libyaml-cpp-dev nlohmann-json3-dev libcli11-dev)
+  libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
+  pybind11-dev python3-dev python3-numpy python3-pytest)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

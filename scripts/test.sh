@@ -12,7 +12,7 @@ cd "$(dirname "$0")/.."
 bash scripts/install_deps.sh
 jobs=${ULC_JOBS:-$(nproc)}
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DULC_ASSERTIONS=ON -DULC_BUILD_TESTS=ON \
-  -DULC_BUILD_APPS=ON -DULC_BUILD_BENCH=OFF -DULC_BUILD_EXAMPLES=OFF
+  -DULC_BUILD_APPS=ON -DULC_BUILD_PYTHON=ON -DULC_BUILD_BENCH=OFF -DULC_BUILD_EXAMPLES=OFF
 cmake --build build -j "$jobs"
 ctest --test-dir build --output-on-failure -j "$jobs"
 

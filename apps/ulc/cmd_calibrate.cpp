@@ -2,29 +2,24 @@
 // for (terra, jeep, hots), written as the result file of docs/design.md and summarised on stdout.
 // The targets form a rig (pipeline/rig.hpp): a target that fails against the base is routed
 // through one that succeeded, and with two targets or more the cycles between them are closed.
-#include <tbb/task_arena.h>
-
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
-#include <optional>
 #include <string>
 #include <vector>
 
-#include "calibrate_frames.hpp"
 #include "calibration_report.hpp"
 #include "command_line.hpp"
 #include "commands.hpp"
-#include "drive_selection.hpp"
 #include "fused_cloud.hpp"
-#include "initial_extrinsic.hpp"
 #include "lidar_input.hpp"
 #include "pipeline/calibrate.hpp"
 #include "pipeline/rig.hpp"
+#include "pipeline/selection.hpp"
 #include "progress.hpp"
-#include "ulc/io/io_error.hpp"
-#include "ulc/io/result_entry.hpp"
+#include "rig_run.hpp"
+#include "ulc/core/lie.hpp"
 #include "ulc/io/result_file.hpp"
 #include "ulc/io/result_yaml.hpp"
 
@@ -52,12 +47,6 @@ class StageProgress {
   std::unique_ptr<Progress> bar_;
 };
 
-std::vector<Stage> stages_option(const std::string& text) {
-  const ParsedStages parsed = parse_stages(text);
-  if (!parsed.ok()) throw UsageError("calibrate: option '--stages': " + parsed.error);
-  return parsed.stages;
-}
-
 /// Fails before the work, not after it, when the result file's folder does not exist.
 void require_output_folder(const std::string& output) {
   const std::filesystem::path folder = std::filesystem::path(output).parent_path();
@@ -68,41 +57,6 @@ void require_output_folder(const std::string& output) {
 
 std::vector<Eigen::Vector3f> points_of(const PointCloud<float>& cloud) {
   return std::vector<Eigen::Vector3f>(cloud.points.begin(), cloud.points.end());
-}
-
-/// The stages of the cycle checks: the pair stages without HOTS (TERRA + JEEP is the cheap,
-/// independent check); HOTS alone leaves JEEP, started from the chained extrinsics.
-std::vector<Stage> cycle_stages(const std::vector<Stage>& stages) {
-  std::vector<Stage> out;
-  for (const Stage s : stages)
-    if (s != Stage::hots) out.push_back(s);
-  if (out.empty()) out.push_back(Stage::jeep);
-  return out;
-}
-
-/// The result-file entry of one target of the rig: its calibration, and for a routed target
-/// the LiDAR it went through and why the direct attempt failed.
-io::PairResult rig_entry(const RigTarget& t, const std::string& base, std::size_t frame_index,
-                         const std::optional<Selection>& selection, double budget) {
-  io::PairResult r = io::to_pair_result(t.result, base, t.name);
-  if (selection) r.stages["selection"] = selection_json(*selection, budget);
-  if (r.stages.contains("terra")) r.stages["terra"]["frame_index"] = frame_index;
-  if (t.routed()) {
-    r.via = t.via_name;
-    r.direct_status = to_string(t.direct.status);
-    r.direct_reason = t.direct.reason;
-  }
-  return r;
-}
-
-io::CycleResult cycle_entry(const RigCycle& c, const std::string& base) {
-  io::CycleResult r;
-  r.lidars = {base, c.name_i, c.name_j};
-  r.status = to_string(c.pair.status);
-  r.reason = c.pair.reason;
-  r.rotation_deg = c.rotation_deg;
-  r.translation_m = c.translation_m;
-  return r;
 }
 
 void print_summary(const io::PairResult& r) {
@@ -255,117 +209,47 @@ void add_stage_options(CLI::App& app, CalibrateArgs& a) {
 
 /// The pipeline's options from the command line; usage errors before any frame is read.
 CalibrateOptions calibrate_options(const CalibrateArgs& a) {
-  CalibrateOptions options;
-  options.stages = stages_option(a.stages_text);
-  const bool run_terra = has_stage(options.stages, Stage::terra);
-  const bool has_initial = a.has(a.initial_option);
-  if (run_terra && has_initial)
-    throw UsageError(
-        "calibrate: option '--initial' is only used when the stages skip terra (TERRA needs no "
-        "guess); use --stages jeep,hots or hots with it");
-  if (!run_terra && !has_initial)
-    throw UsageError("calibrate: --stages " + stages_to_string(options.stages) +
-                     " needs an initial extrinsic: --initial \"x y z roll pitch yaw\" or "
-                     "--initial FILE.json");
-  if (a.synced_clocks) options.time_offset_s = 0.0;
-  if (a.has(a.time_offset_option)) {
-    if (!(std::fabs(a.time_offset) <= 1.0))
-      throw UsageError("calibrate: option '--time-offset' must be within [-1, 1] s");
-    options.time_offset_s = a.time_offset;
-  }
-  options.tuning.jeep.frames = static_cast<std::size_t>(a.frames);
-  if (!run_terra) (void)parse_initial(a.initial, "", "");  // fail before any loading
+  CalibrateChoices c;
+  c.stages = a.stages_text;
+  if (a.has(a.initial_option)) c.initial = a.initial;
+  c.synced_clocks = a.synced_clocks;
+  if (a.has(a.time_offset_option)) c.time_offset_s = a.time_offset;
+  c.frames = static_cast<std::size_t>(a.frames);
+  const CalibrateOptions options = calibrate_options(c);
   for (const CLI::Option* file_option : {a.output_option, a.merged_option, a.report_option})
     if (a.has(file_option)) require_output_folder(file_option->as<std::string>());
   return options;
 }
 
-/// f() run with --threads worker threads when given (else TBB's default).
-template <class F>
-auto in_arena(const CalibrateArgs& a, const F& f) {
-  if (!a.has(a.threads_option)) return f();
-  tbb::task_arena arena(static_cast<int>(a.threads));
-  return arena.execute(f);
+/// --threads, or 0 (TBB's default).
+std::size_t threads_of(const CalibrateArgs& a) {
+  return a.has(a.threads_option) ? static_cast<std::size_t>(a.threads) : 0;
 }
 
-/// Every LiDAR's frames from frame_index, as many as the stages need, read on demand for the
-/// whole rig (routes and cycles pair targets too); the base's are shared by all targets.
-struct LoadedRig {
-  std::optional<Selection> selection;  ///< when the drive was surveyed
-  std::vector<std::unique_ptr<LidarInput>> inputs;
-  std::vector<StreamedFrames> frames;  ///< the base's first
-  std::vector<RigLidar<FrameSource>> lidars;
-};
-
-/// A drive longer than the budget (by more than a frame) and no --start / --duration: the
-/// base's drive is surveyed and the inputs opened again on its best stretch
-/// (pipeline/selection.hpp).
-void choose_stretch(const CalibrateArgs& a, const std::vector<LidarSpec>& specs, InputOptions input,
-                    LoadedRig& rig) {
-  const LidarInput& base = *rig.inputs.front();
-  const bool user_window = input.window.start_s || input.window.duration_s;
-  if (!(a.budget > 0.0) || user_window || base.span_s() <= a.budget + base.period()) return;
-  SelectionOptions so;
-  so.budget_s = a.budget;
-  rig.selection = in_arena(a, [&] { return survey_drive(base, so, a.quiet); });
-  if (!rig.selection->applied) return;
-  input.window.start_s = rig.selection->start_s;
-  input.window.duration_s = a.budget;
-  rig.inputs = open_lidar_inputs(specs, input, "calibrate");
+/// The sources of the command line, base first.
+RigRequest rig_request(const CalibrateArgs& a) {
+  RigRequest r;
+  r.specs.push_back(parse_lidar_spec(a.base_spec, "calibrate", "base"));
+  for (const auto& t : a.target_specs)
+    r.specs.push_back(parse_lidar_spec(t, "calibrate", "target"));
+  r.input = input_options(a.input, "calibrate");
+  r.frame_index = static_cast<std::size_t>(a.frame_index);
+  r.initial = a.initial;
+  r.route = !a.no_route;
+  r.cycles = !a.no_cycles;
+  r.budget_s = a.budget;
+  r.threads = threads_of(a);
+  r.quiet = a.quiet;
+  return r;
 }
 
-LoadedRig load_rig(const CalibrateArgs& a, const CalibrateOptions& options) {
-  const bool run_jeep = has_stage(options.stages, Stage::jeep);
-  const bool run_hots = has_stage(options.stages, Stage::hots);
-  const auto frame_index = static_cast<std::size_t>(a.frame_index);
-  std::vector<LidarSpec> specs{parse_lidar_spec(a.base_spec, "calibrate", "base")};
-  for (const auto& t : a.target_specs) specs.push_back(parse_lidar_spec(t, "calibrate", "target"));
-  LoadedRig rig;
-  const InputOptions input = input_options(a.input, "calibrate");
-  rig.inputs = open_lidar_inputs(specs, input, "calibrate");
-  print_input_warnings(rig.inputs, "calibrate");
-  if (run_hots) choose_stretch(a, specs, input, rig);
-  const LidarInput& base = *rig.inputs.front();
-  const std::size_t base_count = run_hots   ? kAllFrames
-                                 : run_jeep ? jeep_only_count(options, base.period())
-                                            : 1;
-  for (std::size_t k = 0; k < rig.inputs.size(); ++k) {
-    const LidarInput& lidar = *rig.inputs[k];
-    const std::size_t count = k == 0 || run_hots ? base_count
-                              : run_jeep ? covering_count(base.period(), lidar.period(), base_count)
-                                         : 1;
-    rig.frames.push_back(lidar.stream(frame_index, count));
-    require_frame(lidar, rig.frames.back(), frame_index);
-  }
-  for (std::size_t k = 0; k < rig.inputs.size(); ++k) {
-    RigLidar<FrameSource> l{
-        rig.inputs[k]->name(), rig.frames[k].frames.get(), &rig.frames[k].times, {}};
-    if (k > 0 && !has_stage(options.stages, Stage::terra))
-      l.initial = parse_initial(a.initial, base.name(), l.name);
-    rig.lidars.push_back(std::move(l));
-  }
-  return rig;
-}
-
-RigCalibration run_rig(const CalibrateArgs& a, const CalibrateOptions& options,
-                       const LoadedRig& loaded) {
-  RigOptions rig_options;
-  rig_options.pair = options;
-  rig_options.pair.frame_index = 0;  // the loaded frames start at frame_index
-  rig_options.route = !a.no_route;
-  rig_options.cycles = !a.no_cycles && loaded.inputs.size() >= 3;
-  rig_options.cycle_stages = cycle_stages(options.stages);
+RigCalibration calibrate_loaded_rig(const CalibrateArgs& a, const CalibrateOptions& options,
+                                    const LoadedRig& loaded) {
+  RigOptions rig = rig_options(options, !a.no_route, !a.no_cycles, loaded.inputs.size());
+  rig.pair.frame_index = 0;  // the loaded frames start at frame_index
   StageProgress progress(a.quiet);
-  rig_options.pair.progress = [&progress](const std::string& stage, double f) {
-    progress(stage, f);
-  };
-  RigCalibration rig = in_arena(a, [&] { return calibrate_rig(loaded.lidars, 0, rig_options); });
-  // A frame that could not be read reached the stages empty: the result is not to be trusted.
-  for (std::size_t k = 0; k < loaded.frames.size(); ++k)
-    if (const std::string why = loaded.frames[k].frames->error(); !why.empty())
-      throw io::IoError(loaded.inputs[k]->source(), "", "a frame could not be read: " + why);
-  if (rig.status == RigStatus::invalid_input) throw UsageError("calibrate: " + rig.reason);
-  return rig;
+  rig.pair.progress = [&progress](const std::string& stage, double f) { progress(stage, f); };
+  return run_rig(loaded, rig, threads_of(a));
 }
 
 /// The result file's entries, printed as they are made, and the pictures' clouds: a failed
@@ -380,24 +264,24 @@ struct RigOutputs {
 RigOutputs rig_outputs(const CalibrateArgs& a, const LoadedRig& loaded, const RigCalibration& rig) {
   const std::string& base = loaded.lidars.front().name;
   RigOutputs out;
+  io::ResultDocument entries =
+      rig_entries(rig, static_cast<std::size_t>(a.frame_index), loaded.selection, loaded.budget_s);
   out.fused.push_back({points_of(loaded.frames.front().frames->load(0)), Isometry3d::Identity()});
   out.report.push_back(
       {base, out.fused.front().points, Isometry3d::Identity(), Isometry3d::Identity()});
   const bool pictures = a.has(a.merged_option) || a.has(a.report_option);
-  for (const RigTarget& t : rig.targets) {
-    out.results.push_back(
-        rig_entry(t, base, static_cast<std::size_t>(a.frame_index), loaded.selection, a.budget));
-    print_summary(out.results.back());
+  out.results = std::move(entries.results);
+  out.cycles = std::move(entries.cycles);
+  for (std::size_t k = 0; k < rig.targets.size(); ++k) {
+    const RigTarget& t = rig.targets[k];
+    print_summary(out.results[k]);
     if (!pictures) continue;
     const Isometry3d before = loaded.lidars[t.lidar].initial.value_or(Isometry3d::Identity());
     const Isometry3d after = t.ok() ? t.result.T_base_target : before;
     out.fused.push_back({points_of(loaded.frames[t.lidar].frames->load(0)), after});
     out.report.push_back({t.name, out.fused.back().points, before, after});
   }
-  for (const RigCycle& c : rig.cycles) {
-    out.cycles.push_back(cycle_entry(c, base));
-    print_cycle(out.cycles.back());
-  }
+  for (const io::CycleResult& c : out.cycles) print_cycle(c);
   return out;
 }
 
@@ -437,8 +321,9 @@ int run_calibrate(int argc, char** argv) {
   add_stage_options(app, args);
   if (parse_command_line(app, "calibrate", argc, argv)) return kExitOk;
   const CalibrateOptions options = calibrate_options(args);
-  const LoadedRig loaded = load_rig(args, options);
-  const RigCalibration rig = run_rig(args, options, loaded);
+  const RigRequest request = rig_request(args);
+  const LoadedRig loaded = load_rig(request, options);
+  const RigCalibration rig = calibrate_loaded_rig(args, options, loaded);
   const RigOutputs out = rig_outputs(args, loaded, rig);
   write_outputs(args, out);
   for (const auto& r : out.results)

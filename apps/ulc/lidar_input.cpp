@@ -281,18 +281,28 @@ void add_input_options(CLI::App& app, InputArgs& args) {
   add_frame_time_option(app, args);
 }
 
-InputOptions input_options(const InputArgs& args, const std::string& command) {
+InputOptions input_options(std::optional<double> start_s, std::optional<double> duration_s,
+                           const std::string& frame_time, const std::string& command) {
   InputOptions o;
-  if (args.start && args.start->count() > 0)
-    o.window.start_s = non_negative(args.start_s, "start", command);
-  if (args.duration && args.duration->count() > 0) {
-    o.window.duration_s = non_negative(args.duration_s, "duration", command);
+  if (start_s) o.window.start_s = non_negative(*start_s, "start", command);
+  if (duration_s) {
+    o.window.duration_s = non_negative(*duration_s, "duration", command);
     if (*o.window.duration_s <= 0.0)
       throw UsageError(command + ": option '--duration' must be more than 0 seconds");
   }
+  if (frame_time != "header" && frame_time != "receive")
+    throw UsageError(command + ": option '--frame-time' must be header or receive");
   o.frame_time =
-      args.frame_time == "receive" ? FrameTimeChoice::receive_time : FrameTimeChoice::header_stamp;
+      frame_time == "receive" ? FrameTimeChoice::receive_time : FrameTimeChoice::header_stamp;
   return o;
+}
+
+InputOptions input_options(const InputArgs& args, const std::string& command) {
+  const auto given = [](const CLI::Option* o, double v) {
+    return o && o->count() > 0 ? std::optional<double>(v) : std::nullopt;
+  };
+  return input_options(given(args.start, args.start_s), given(args.duration, args.duration_s),
+                       args.frame_time, command);
 }
 
 void print_input_warnings(const std::vector<std::unique_ptr<LidarInput>>& inputs,

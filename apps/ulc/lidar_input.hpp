@@ -30,6 +30,12 @@ class Option;
 
 namespace ulc::app {
 
+/// Frames all held, and their times (Python's read_frames returns them all).
+struct LoadedFrames {
+  std::vector<PointCloud<float>> clouds;  ///< per-point times relative to the frame
+  std::vector<double> times;              ///< seconds, the LiDAR's own clock
+};
+
 /// Frames read on demand (ulc/core/frame_source.hpp) and their times.
 struct StreamedFrames {
   std::unique_ptr<FrameSource> frames;
@@ -77,6 +83,16 @@ class LidarInput {
   /// Reads frames first .. first + count - 1 of the selection (fewer when it ends first) one at a
   /// time, in time order, handing each to `visit`.
   virtual void visit(std::size_t first, std::size_t count, const FrameVisitor& visit) const = 0;
+  /// The same frames, all held.
+  LoadedFrames load(std::size_t first, std::size_t count) const {
+    LoadedFrames out;
+    visit(first, count, [&out](PointCloud<float>&& cloud, double time) {
+      out.clouds.push_back(std::move(cloud));
+      out.times.push_back(time);
+      return true;
+    });
+    return out;
+  }
   /// The same frames, read on demand: a folder reads each file when a stage asks for it; a
   /// recording, which reads only in order, is copied once into a temporary file (frame_spool.hpp).
   virtual StreamedFrames stream(std::size_t first, std::size_t count) const;
@@ -114,6 +130,9 @@ void add_input_options(CLI::App& app, InputArgs& args);
 void add_frame_time_option(CLI::App& app, InputArgs& args);
 /// Reads them back (UsageError for a negative start or a duration that is not positive).
 InputOptions input_options(const InputArgs& args, const std::string& command);
+/// The same from values (unset: not given); frame_time is "header" or "receive".
+InputOptions input_options(std::optional<double> start_s, std::optional<double> duration_s,
+                           const std::string& frame_time, const std::string& command);
 
 /// Prints each input's warnings on stderr as "ulc COMMAND: warning: SOURCE: ...".
 void print_input_warnings(const std::vector<std::unique_ptr<LidarInput>>& inputs,

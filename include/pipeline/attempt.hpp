@@ -232,22 +232,20 @@ inline std::string hots_failure(const hots::RefineResult& h) {
   return why;
 }
 
-/// Why HOTS's estimated clock offset cannot be trusted although HOTS's own checks passed: the
-/// odometry it was synchronised on did not see the motion (StageTuning::min_odometry_condition);
-/// empty when it can be, or when the offset was given.
-template <class FA, class FB>
-std::string odometry_offset_doubt(const AttemptInputs<FA, FB>& in, const HotsReport& h) {
-  if (!in.hots.synchronise_time || h.odometry_condition >= in.options.tuning.min_odometry_condition)
-    return "";
+/// Why HOTS's answer cannot be used although HOTS's own checks passed: the odometry it built on
+/// did not see the motion along some direction (StageTuning::min_odometry_condition); empty
+/// when it did.
+inline std::string odometry_doubt(const HotsReport& h, const StageTuning& tuning) {
+  if (h.odometry_condition >= tuning.min_odometry_condition) return "";
   char text[96];
   std::snprintf(text, sizeof(text), "%.4f (at least %.4f needed)", h.odometry_condition,
-                in.options.tuning.min_odometry_condition);
+                tuning.min_odometry_condition);
   return std::string(
              "the odometry's registrations leave a direction nearly free (median "
              "condition ") +
          text +
-         ": a tunnel or a straight road), so the motion the clock offset was synchronised on "
-         "is not observed along it";
+         ": a tunnel or a straight road): the trajectory HOTS builds on, and a clock offset "
+         "read from it, are not observed along that direction";
 }
 
 /// The odometry over every frame, then hots::refine on its poses.
@@ -282,14 +280,11 @@ StageOutcome hots_step(const AttemptInputs<FA, FB>& in, Attempt& at) {
     return failed_after_jeep(
         at, CalibrateStatus::hots_failed, hots_failure(h),
         h.status == hots::RefineStatus::extrinsic_unconfirmed || !at.jeep_failure.empty());
-  if (std::string doubt = odometry_offset_doubt(in, *at.out.hots); !doubt.empty()) {
-    at.out.hots->status = hots::RefineStatus::time_offset_untrusted;
+  if (std::string doubt = odometry_doubt(*at.out.hots, in.options.tuning); !doubt.empty()) {
+    at.out.hots->run = HotsRun::odometry_degenerate;
     at.out.hots->reason = doubt;
     return failed_after_jeep(at, CalibrateStatus::hots_failed,
-                             "HOTS: time_offset_untrusted: " + doubt +
-                                 "; synchronised clocks are said so with time_offset_s = 0 (ulc "
-                                 "calibrate --synced-clocks)",
-                             !at.jeep_failure.empty());
+                             "HOTS: odometry_degenerate: " + doubt, !at.jeep_failure.empty());
   }
   notify(in.options, hots_stage, 1.0);
   at.out.T_base_target = h.extrinsic;

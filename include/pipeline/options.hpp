@@ -40,13 +40,14 @@ struct StageTuning {
   /// has no motion to work with, so after TERRA or JEEP it is skipped (stages.hots says so) and
   /// their extrinsic is the answer; as the only stage it fails.
   std::size_t hots_min_frames = 10;
-  /// HOTS's clock offset is trusted only when the odometry it was synchronised on saw the motion:
-  /// the median condition of its steps (odometry::median_condition) at least this. In a tunnel
-  /// the odometry follows its motion model along the tunnel, the two LiDARs' trajectories lag
-  /// each other there, and the time synchronisation reads that lag as a clock offset
-  /// (tunnel 8 s drives: offsets 13-43 ms off, trusted by every other check, translations
-  /// 11-39 cm off). Degenerate drives 0.003-0.011, the others 0.067 and up: 0.03 lies between
-  /// (docs/experiments/degenerate_scenes.md). A given offset (time_offset_s) is not checked.
+  /// HOTS's answer is used only when the odometry it built on saw the motion: the median
+  /// condition of its steps (odometry::median_condition) at least this, else hots_failed with
+  /// stages.hots.status odometry_degenerate. In a tunnel the odometry follows its motion model
+  /// along the tunnel: the two LiDARs' trajectories lag each other there (read as a clock
+  /// offset: 8 s drives 13-43 ms off, trusted by HOTS's own checks, translations 11-39 cm off)
+  /// and the submaps are placed wrongly along it (with the clocks given: 11.6 and 12.5 cm off,
+  /// ok). Degenerate drives 0.003-0.014, the others 0.067 and up: 0.03 lies between
+  /// (docs/experiments/degenerate_scenes.md).
   double min_odometry_condition = 0.03;
   /// What the data cannot vouch for: an unestimated clock offset, frames without point times
   /// (pipeline/vouch.hpp).

@@ -155,6 +155,9 @@ enum class HotsRun {
   refined,          ///< hots::refine ran: HotsReport::status says how it ended
   skipped,          ///< too few frames for HOTS: the previous stage's extrinsic stands
   odometry_failed,  ///< the odometry before it gave no poses: HOTS did not run
+  /// HOTS ran, but the odometry it built on did not see the motion along some direction
+  /// (odometry_condition below StageTuning::min_odometry_condition): its answer is not used
+  odometry_degenerate,
 };
 
 /// The HOTS stage: odometry over every frame from frame_index, then hots::refine.

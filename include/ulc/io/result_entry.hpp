@@ -140,6 +140,8 @@ inline std::string hots_status_text(const HotsReport& h) {
       return "skipped";
     case HotsRun::odometry_failed:
       return "not_run";
+    case HotsRun::odometry_degenerate:
+      return "odometry_degenerate";
     default:
       return hots::to_string(h.status);
   }

@@ -1,0 +1,75 @@
+#!/usr/bin/env python3
+"""Simulate a rig, calibrate it with no initial guess, and show the clouds before and after.
+
+  PYTHONPATH=build/python python3 examples/python/calibrate_rig.py [--scenario 64-horizon]
+
+Prints the extrinsic found next to the simulator's truth. With Open3D (Debian's python3-open3d)
+and a display, it opens two windows: the base's first frame (grey) with the target's placed by
+no guess (identity), then by the calibration (orange). Without either, it skips the windows.
+"""
+import argparse
+import os
+
+import numpy as np
+
+import ulc
+
+
+def angle_deg(R):
+    return np.degrees(np.arccos(np.clip((np.trace(R) - 1) / 2, -1, 1)))
+
+
+def show(title, base_points, target_points, T):
+    """The base's frame and the target's moved by T, in one Open3D window."""
+    import open3d as o3d
+    clouds = []
+    for points, colour, pose in ((base_points, (0.6, 0.6, 0.6), np.eye(4)),
+                                 (target_points, (1.0, 0.5, 0.0), T)):
+        xyz = np.ascontiguousarray(points[:, :3], dtype=np.float64)
+        cloud = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(xyz))
+        cloud.paint_uniform_color(colour)
+        clouds.append(cloud.transform(pose))
+    o3d.visualization.draw_geometries(clouds, window_name=title)
+
+
+def can_show():
+    if not os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY"):
+        print("no display: the windows are skipped")
+        return False
+    try:
+        import open3d  # noqa: F401
+    except ImportError:
+        print("no open3d (apt-get install python3-open3d): the windows are skipped")
+        return False
+    return True
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--scenario", default="64-horizon", help="see ulc.scenarios()")
+    p.add_argument("--seconds", type=float, default=20.0)
+    args = p.parse_args()
+
+    print(f"simulating {args.seconds:g} s of {args.scenario} ...")
+    drive = ulc.simulate(args.scenario, seconds=args.seconds)
+    base, target = drive["lidars"][:2]
+    result = ulc.calibrate(base["frames"], target["frames"], base_times=base["times"],
+                           target_times=target["times"], names=[base["name"], target["name"]],
+                           progress=lambda stage, f: print(f"\r{stage:24s} {100 * f:5.1f} %",
+                                                           end="", flush=True))
+    print()
+    print(result.status, result.reason)
+    truth = next(t for t in drive["truth"]
+                 if (t["base"], t["target"]) == (base["name"], target["name"]))
+    T, T_true = result.T_base_target, truth["T_base_target"]
+    E = np.linalg.inv(T_true) @ T
+    print("T_base_target =\n", np.array2string(T, precision=4, suppress_small=True))
+    print(f"error against the truth: {angle_deg(E[:3, :3]):.4f} deg, "
+          f"{100 * np.linalg.norm(E[:3, 3]):.2f} cm; clock offset {result.time_offset_s} s")
+    if can_show():
+        show("before: no guess", base["frames"][0], target["frames"][0], np.eye(4))
+        show("after: ULC's extrinsic", base["frames"][0], target["frames"][0], T)
+
+
+if __name__ == "__main__":
+    main()
