@@ -12,6 +12,7 @@
 #include "errors.hpp"
 #include "frames.hpp"
 #include "initial_extrinsic.hpp"
+#include "pipeline/selection.hpp"
 #include "results.hpp"
 #include "rig_run.hpp"
 
@@ -24,6 +25,7 @@ struct CalibrateKeywords {
   py::object initial;  ///< None, text as --initial, a 4x4 array, or a list of them per target
   std::size_t frame_index = 0;
   std::size_t threads = 0;
+  double budget_s = SelectionOptions{}.budget_s;  ///< paths only: as --budget
   bool route = true, cycles = true;
   app::InputOptions input;
   py::object names;     ///< None or one name per LiDAR, base first
@@ -128,18 +130,35 @@ app::RigRequest path_request(const std::vector<Source>& sources, const Calibrate
   }
   r.input = k.input;
   r.frame_index = k.frame_index;
+  r.budget_s = k.budget_s;
+  r.threads = k.threads;
   if (const auto text = initial_text(k.initial)) r.initial = *text;
   return r;
 }
 
-RigResult run(const std::vector<RigLidar<FloatFrames>>& lidars, const CalibrateOptions& options,
-              const CalibrateKeywords& k) {
-  RigOptions rig = app::rig_options(options, k.route, k.cycles, lidars.size());
+RigOptions rig_options(const CalibrateOptions& options, const CalibrateKeywords& k,
+                       std::size_t lidar_count) {
+  RigOptions rig = app::rig_options(options, k.route, k.cycles, lidar_count);
   rig.pair.frame_index = 0;  // every LiDAR's frames start at frame_index
   rig.pair.progress = python_progress(k.progress);
+  return rig;
+}
+
+RigResult run(const std::vector<RigLidar<FloatFrames>>& lidars, const CalibrateOptions& options,
+              const CalibrateKeywords& k) {
+  const RigOptions rig = rig_options(options, k, lidars.size());
   const RigCalibration calibration =
       without_gil([&] { return app::run_rig(lidars, rig, k.threads); });
   return RigResult{app::rig_entries(calibration, k.frame_index)};
+}
+
+/// The same on sources read on demand, as `ulc calibrate` does (stages.selection when surveyed).
+RigResult run(const app::LoadedRig& loaded, const CalibrateOptions& options,
+              const CalibrateKeywords& k) {
+  const RigOptions rig = rig_options(options, k, loaded.lidars.size());
+  const RigCalibration calibration =
+      without_gil([&] { return app::run_rig(loaded, rig, k.threads); });
+  return RigResult{app::rig_entries(calibration, k.frame_index, loaded.selection, loaded.budget_s)};
 }
 
 RigResult calibrate_rig_sources(const std::vector<Source>& sources, CalibrateKeywords& k) {
@@ -160,7 +179,7 @@ RigResult calibrate_rig_sources(const std::vector<Source>& sources, CalibrateKey
     const CalibrateOptions options = app::calibrate_options(k.choices);
     if (paths) {
       const app::LoadedRig loaded = app::load_rig(path_request(sources, k), options);
-      return run(loaded.lidars, options, k);
+      return run(loaded, options, k);
     }
     ArrayRig rig;
     read_arrays(sources, k, rig);
@@ -191,7 +210,8 @@ Open3D clouds too) with one timestamp per frame in *_times (seconds, the LiDAR's
 target= calibrates a pair and returns a Result; targets=[...] (with target_times=[...]) a rig
 and returns a RigResult. The other keywords mirror `ulc calibrate --help`: stages, initial
 (text as --initial, or 4x4 arrays), frame_index, frames, synced_clocks, time_offset, threads,
-route (not --no-route), cycles (not --no-cycles), start, duration, frame_time; names gives each
+route (not --no-route), cycles (not --no-cycles), start, duration, frame_time, budget (paths:
+seconds HOTS calibrates on, a longer drive's best stretch chosen; 0: all); names gives each
 LiDAR's name (base first). progress(stage, fraction) is called between steps. Bad input raises
 ulc.Error with the command line's message; Ctrl-C raises KeyboardInterrupt.)";
 
@@ -236,7 +256,7 @@ void bind_calibrate(py::module_& m) {
          const py::object& initial, std::size_t frame_index, std::size_t frames, bool synced_clocks,
          std::optional<double> time_offset, std::size_t threads, bool route, bool cycles,
          std::optional<double> start, std::optional<double> duration, const std::string& frame_time,
-         const py::object& names, const py::object& progress) {
+         double budget, const py::object& names, const py::object& progress) {
         CalibrateKeywords k;
         k.choices.stages = stages_text(stages);
         k.choices.frames = frames;
@@ -247,6 +267,8 @@ void bind_calibrate(py::module_& m) {
         k.threads = threads;
         k.route = route;
         k.cycles = cycles;
+        if (!(budget >= 0.0)) raise_error("ulc calibrate: budget must be 0 or more seconds");
+        k.budget_s = budget;
         k.input = with_cli_errors("calibrate", [&] {
           return app::input_options(start, duration, frame_time, "calibrate");
         });
@@ -261,8 +283,8 @@ void bind_calibrate(py::module_& m) {
       py::arg("frames") = jeep::JeepOptions{}.frames, py::arg("synced_clocks") = false,
       py::arg("time_offset") = py::none(), py::arg("threads") = 0, py::arg("route") = true,
       py::arg("cycles") = true, py::arg("start") = py::none(), py::arg("duration") = py::none(),
-      py::arg("frame_time") = "header", py::arg("names") = py::none(),
-      py::arg("progress") = py::none());
+      py::arg("frame_time") = "header", py::arg("budget") = SelectionOptions{}.budget_s,
+      py::arg("names") = py::none(), py::arg("progress") = py::none());
 }
 
 }  // namespace ulc::python

@@ -36,8 +36,9 @@ inline std::size_t jeep_only_count(const CalibrateOptions& options, double base_
 }
 
 /// UsageError unless frame `index` was there to load.
-inline void require_frame(const LidarInput& input, const LoadedFrames& loaded, std::size_t index) {
-  if (loaded.clouds.empty())
+inline void require_frame(const LidarInput& input, const StreamedFrames& frames,
+                          std::size_t index) {
+  if (frames.times.empty())
     throw UsageError("calibrate: --frame-index " + std::to_string(index) +
                      " is past the last frame of " + input.source());
 }

@@ -16,6 +16,7 @@
 #include "lidar_input.hpp"
 #include "pipeline/calibrate.hpp"
 #include "pipeline/rig.hpp"
+#include "pipeline/selection.hpp"
 #include "progress.hpp"
 #include "rig_run.hpp"
 #include "ulc/core/lie.hpp"
@@ -37,7 +38,7 @@ class StageProgress {
       stage_ = stage;
       bar_ = std::make_unique<Progress>(stage, quiet_);
     }
-    bar_->update(static_cast<std::size_t>(fraction * 100.0 + 0.5), 100);
+    bar_->update_fraction(fraction);
   }
 
  private:
@@ -73,6 +74,10 @@ void print_summary(const io::PairResult& r) {
           "(stages.terra.hypotheses)\n",
           tried->size(), terra->at("hypothesis_used").get<double>() + 1.0);
   }
+  if (const io::Json* s = io::find_member(r.stages, "selection"); s && s->at("applied").get<bool>())
+    std::printf("  stretch %.0f-%.0f s of the %.0f s drive (stages.selection)\n",
+                s->at("start_s").get<double>(), s->at("end_s").get<double>(),
+                s->at("drive_s").get<double>());
   for (const auto& d : r.unobservable) std::printf("  free    %s\n", d.words.c_str());
   const Eigen::Vector3d t = r.T_base_target.translation();
   const Eigen::Vector3d rpy = ulc::rpy_from_rotation(r.T_base_target.linear()) * kDeg;
@@ -121,6 +126,7 @@ struct CalibrateArgs {
   // Set when the user gave them.
   CLI::Option *output_option = nullptr, *merged_option = nullptr, *report_option = nullptr,
               *initial_option = nullptr, *threads_option = nullptr;
+  double budget = SelectionOptions{}.budget_s;  ///< --budget
   double time_offset = 0.0;  ///< --time-offset: a known offset of every target's clock
   CLI::Option* time_offset_option = nullptr;
 
@@ -139,6 +145,12 @@ void add_source_options(CLI::App& app, CalibrateArgs& a) {
       ->required()
       ->allow_extra_args(false);
   add_input_options(app, a.input);
+  app.add_option("--budget", a.budget,
+                 "seconds of data HOTS calibrates on: a longer drive is surveyed and its best "
+                 "stretch of S seconds used (stages.selection says which and why); 0: the whole "
+                 "drive; --start / --duration choose the stretch yourself (default 60)")
+      ->type_name("S")
+      ->check(CLI::Range(0.0, 1e9));
 }
 
 void add_output_options(CLI::App& app, CalibrateArgs& a) {
@@ -209,6 +221,11 @@ CalibrateOptions calibrate_options(const CalibrateArgs& a) {
   return options;
 }
 
+/// --threads, or 0 (TBB's default).
+std::size_t threads_of(const CalibrateArgs& a) {
+  return a.has(a.threads_option) ? static_cast<std::size_t>(a.threads) : 0;
+}
+
 /// The sources of the command line, base first.
 RigRequest rig_request(const CalibrateArgs& a) {
   RigRequest r;
@@ -220,6 +237,9 @@ RigRequest rig_request(const CalibrateArgs& a) {
   r.initial = a.initial;
   r.route = !a.no_route;
   r.cycles = !a.no_cycles;
+  r.budget_s = a.budget;
+  r.threads = threads_of(a);
+  r.quiet = a.quiet;
   return r;
 }
 
@@ -229,8 +249,7 @@ RigCalibration calibrate_loaded_rig(const CalibrateArgs& a, const CalibrateOptio
   rig.pair.frame_index = 0;  // the loaded frames start at frame_index
   StageProgress progress(a.quiet);
   rig.pair.progress = [&progress](const std::string& stage, double f) { progress(stage, f); };
-  return run_rig(loaded.lidars, rig,
-                 a.has(a.threads_option) ? static_cast<std::size_t>(a.threads) : 0);
+  return run_rig(loaded, rig, threads_of(a));
 }
 
 /// The result file's entries, printed as they are made, and the pictures' clouds: a failed
@@ -245,8 +264,9 @@ struct RigOutputs {
 RigOutputs rig_outputs(const CalibrateArgs& a, const LoadedRig& loaded, const RigCalibration& rig) {
   const std::string& base = loaded.lidars.front().name;
   RigOutputs out;
-  io::ResultDocument entries = rig_entries(rig, static_cast<std::size_t>(a.frame_index));
-  out.fused.push_back({points_of(loaded.frames.front().clouds.front()), Isometry3d::Identity()});
+  io::ResultDocument entries =
+      rig_entries(rig, static_cast<std::size_t>(a.frame_index), loaded.selection, loaded.budget_s);
+  out.fused.push_back({points_of(loaded.frames.front().frames->load(0)), Isometry3d::Identity()});
   out.report.push_back(
       {base, out.fused.front().points, Isometry3d::Identity(), Isometry3d::Identity()});
   const bool pictures = a.has(a.merged_option) || a.has(a.report_option);
@@ -258,7 +278,7 @@ RigOutputs rig_outputs(const CalibrateArgs& a, const LoadedRig& loaded, const Ri
     if (!pictures) continue;
     const Isometry3d before = loaded.lidars[t.lidar].initial.value_or(Isometry3d::Identity());
     const Isometry3d after = t.ok() ? t.result.T_base_target : before;
-    out.fused.push_back({points_of(loaded.frames[t.lidar].clouds.front()), after});
+    out.fused.push_back({points_of(loaded.frames[t.lidar].frames->load(0)), after});
     out.report.push_back({t.name, out.fused.back().points, before, after});
   }
   for (const io::CycleResult& c : out.cycles) print_cycle(c);

@@ -10,6 +10,7 @@
 #include <set>
 
 #include "command_line.hpp"
+#include "frame_spool.hpp"
 #include "odometry/frame_pairing.hpp"
 #include "ulc/bags/cloud_topic.hpp"
 #include "ulc/bags/recording.hpp"
@@ -41,6 +42,26 @@ SecondsRange range_after(double origin, const InputWindow& w) {
   return r;
 }
 
+/// Frames of a folder, each file read when asked for.
+class FolderFrames : public FrameSource {
+ public:
+  FolderFrames(const io::Sequence& seq, std::vector<std::size_t> files)
+      : seq_(seq), files_(std::move(files)) {}
+  std::size_t size() const override { return files_.size(); }
+  PointCloud<float> load(std::size_t i) const override {
+    try {
+      return seq_.load_frame<PointCloud<float>>(files_[i]).cloud;
+    } catch (const std::exception& e) {
+      fail(e.what());
+      return {};
+    }
+  }
+
+ private:
+  const io::Sequence& seq_;
+  std::vector<std::size_t> files_;
+};
+
 class FolderInput : public LidarInput {
  public:
   FolderInput(const std::string& path, const InputWindow& window) : seq_(path) {
@@ -67,10 +88,27 @@ class FolderInput : public LidarInput {
     }
   }
 
-  double period() const override {
+  std::vector<double> frame_times() const override {
     std::vector<double> t;
     for (const std::size_t i : selected_) t.push_back(seq_.frame(i).timestamp);
-    return odometry::frame_period(t);
+    return t;
+  }
+
+  StreamedFrames stream(std::size_t first, std::size_t count) const override {
+    StreamedFrames out;
+    std::vector<std::size_t> files;
+    for (std::size_t k = first; k < selected_.size() && files.size() < count; ++k) {
+      files.push_back(selected_[k]);
+      out.times.push_back(seq_.frame(selected_[k]).timestamp);
+    }
+    out.frames = std::make_unique<FolderFrames>(seq_, std::move(files));
+    return out;
+  }
+
+  double period() const override { return odometry::frame_period(frame_times()); }
+
+  double span_s() const override {
+    return seq_.frame(selected_.back()).timestamp - seq_.frame(selected_.front()).timestamp;
   }
 
   /// The rate or unit the reader assumed (io::Sequence::notes).
@@ -162,6 +200,11 @@ class TopicInput : public LidarInput {
            static_cast<double>(t.message_count - 1);
   }
 
+  double span_s() const override {
+    const auto& t = topic_.info();
+    return static_cast<double>(t.last_time_ns - t.first_time_ns) * 1e-9;
+  }
+
   std::vector<std::string> warnings() const override { return rec_->source->warnings(); }
 
  private:
@@ -208,6 +251,18 @@ double non_negative(double v, const char* name, const std::string& command) {
 }
 
 }  // namespace
+
+StreamedFrames LidarInput::stream(std::size_t first, std::size_t count) const {
+  auto spool = std::make_unique<SpooledFrames>(source());
+  StreamedFrames out;
+  visit(first, count, [&](PointCloud<float>&& cloud, double time) {
+    spool->append(cloud);
+    out.times.push_back(time);
+    return true;
+  });
+  out.frames = std::move(spool);
+  return out;
+}
 
 void add_frame_time_option(CLI::App& app, InputArgs& args) {
   app.add_option("--frame-time", args.frame_time,

@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "ulc/core/frame_source.hpp"
 #include "ulc/core/point_cloud.hpp"
 
 namespace CLI {
@@ -29,9 +30,16 @@ class Option;
 
 namespace ulc::app {
 
+/// Frames all held, and their times (Python's read_frames returns them all).
 struct LoadedFrames {
   std::vector<PointCloud<float>> clouds;  ///< per-point times relative to the frame
   std::vector<double> times;              ///< seconds, the LiDAR's own clock
+};
+
+/// Frames read on demand (ulc/core/frame_source.hpp) and their times.
+struct StreamedFrames {
+  std::unique_ptr<FrameSource> frames;
+  std::vector<double> times;  ///< seconds, the LiDAR's own clock
 };
 
 struct LidarSpec {
@@ -85,6 +93,13 @@ class LidarInput {
     });
     return out;
   }
+  /// The same frames, read on demand: a folder reads each file when a stage asks for it; a
+  /// recording, which reads only in order, is copied once into a temporary file (frame_spool.hpp).
+  virtual StreamedFrames stream(std::size_t first, std::size_t count) const;
+  /// The frames' times when known without reading them (a folder's), else empty.
+  virtual std::vector<double> frame_times() const { return {}; }
+  /// Seconds from the first frame to the last.
+  virtual double span_s() const = 0;
   /// Median frame period in seconds (0 when unknown), for pairing frame counts.
   virtual double period() const = 0;
   /// What the reader had to work around (an unindexed bag, ...), one line each.

@@ -3,10 +3,14 @@
 #include <tbb/task_arena.h>
 
 #include <cmath>
+#include <optional>
+#include <string>
 #include <utility>
 
 #include "calibrate_frames.hpp"
+#include "drive_selection.hpp"
 #include "initial_extrinsic.hpp"
+#include "ulc/io/io_error.hpp"
 #include "ulc/io/result_entry.hpp"
 #include "usage_error.hpp"
 
@@ -25,8 +29,10 @@ std::vector<Stage> cycle_stages(const std::vector<Stage>& stages) {
 
 /// The result-file entry of one target of the rig: its calibration, and for a routed target
 /// the LiDAR it went through and why the direct attempt failed.
-io::PairResult rig_entry(const RigTarget& t, const std::string& base, std::size_t frame_index) {
+io::PairResult rig_entry(const RigTarget& t, const std::string& base, std::size_t frame_index,
+                         const std::optional<Selection>& selection, double budget_s) {
   io::PairResult r = io::to_pair_result(t.result, base, t.name);
+  if (selection) r.stages["selection"] = selection_json(*selection, budget_s);
   if (r.stages.contains("terra")) r.stages["terra"]["frame_index"] = frame_index;
   if (t.routed()) {
     r.via = t.via_name;
@@ -64,6 +70,43 @@ std::size_t frames_to_read(const CalibrateOptions& options, const LidarInput& ba
   return run_jeep ? covering_count(base.period(), lidar.period(), base_count) : 1;
 }
 
+/// f() run with `threads` worker threads (0: TBB's default).
+template <class F>
+auto in_arena(std::size_t threads, const F& f) {
+  if (threads == 0) return f();
+  tbb::task_arena arena(static_cast<int>(threads));
+  return arena.execute(f);
+}
+
+/// A drive longer than the budget (by more than a frame) and no --start / --duration: the
+/// base's drive is surveyed and the inputs opened again on its best stretch
+/// (pipeline/selection.hpp).
+void choose_stretch(const RigRequest& request, LoadedRig& rig) {
+  const LidarInput& base = *rig.inputs.front();
+  InputOptions input = request.input;
+  const bool user_window = input.window.start_s || input.window.duration_s;
+  const double budget = request.budget_s;
+  if (!(budget > 0.0) || user_window || base.span_s() <= budget + base.period()) return;
+  SelectionOptions so;
+  so.budget_s = budget;
+  rig.budget_s = budget;
+  rig.selection = in_arena(request.threads, [&] { return survey_drive(base, so, request.quiet); });
+  if (!rig.selection->applied) return;
+  input.window.start_s = rig.selection->start_s;
+  input.window.duration_s = budget;
+  rig.inputs = open_lidar_inputs(request.specs, input, "calibrate");
+}
+
+template <class Frames>
+RigCalibration calibrate_in_arena(const std::vector<RigLidar<Frames>>& lidars,
+                                  const RigOptions& options, std::size_t threads) {
+  return in_arena(threads, [&] { return calibrate_rig(lidars, 0, options); });
+}
+
+void require_valid(const RigCalibration& rig) {
+  if (rig.status == RigStatus::invalid_input) throw UsageError("calibrate: " + rig.reason);
+}
+
 }  // namespace
 
 CalibrateOptions calibrate_options(const CalibrateChoices& c) {
@@ -96,15 +139,17 @@ LoadedRig load_rig(const RigRequest& request, const CalibrateOptions& options) {
   LoadedRig rig;
   rig.inputs = open_lidar_inputs(request.specs, request.input, "calibrate");
   print_input_warnings(rig.inputs, "calibrate");
+  if (has_stage(options.stages, Stage::hots)) choose_stretch(request, rig);
   const LidarInput& base = *rig.inputs.front();
   for (std::size_t k = 0; k < rig.inputs.size(); ++k) {
     const LidarInput& lidar = *rig.inputs[k];
     rig.frames.push_back(
-        lidar.load(request.frame_index, frames_to_read(options, base, lidar, k == 0)));
+        lidar.stream(request.frame_index, frames_to_read(options, base, lidar, k == 0)));
     require_frame(lidar, rig.frames.back(), request.frame_index);
   }
   for (std::size_t k = 0; k < rig.inputs.size(); ++k) {
-    RigLidar<FloatFrames> l{rig.inputs[k]->name(), &rig.frames[k].clouds, &rig.frames[k].times, {}};
+    RigLidar<FrameSource> l{
+        rig.inputs[k]->name(), rig.frames[k].frames.get(), &rig.frames[k].times, {}};
     if (k > 0 && !has_stage(options.stages, Stage::terra))
       l.initial = parse_initial(request.initial, base.name(), l.name);
     rig.lidars.push_back(std::move(l));
@@ -124,18 +169,25 @@ RigOptions rig_options(const CalibrateOptions& options, bool route, bool cycles,
 
 RigCalibration run_rig(const std::vector<RigLidar<FloatFrames>>& lidars, const RigOptions& options,
                        std::size_t threads) {
-  auto run = [&] { return calibrate_rig(lidars, 0, options); };
-  std::optional<tbb::task_arena> arena;
-  if (threads > 0) arena.emplace(static_cast<int>(threads));
-  RigCalibration rig = arena ? arena->execute(run) : run();
-  if (rig.status == RigStatus::invalid_input) throw UsageError("calibrate: " + rig.reason);
+  RigCalibration rig = calibrate_in_arena(lidars, options, threads);
+  require_valid(rig);
   return rig;
 }
 
-io::ResultDocument rig_entries(const RigCalibration& rig, std::size_t frame_index) {
+RigCalibration run_rig(const LoadedRig& loaded, const RigOptions& options, std::size_t threads) {
+  RigCalibration rig = calibrate_in_arena(loaded.lidars, options, threads);
+  for (std::size_t k = 0; k < loaded.frames.size(); ++k)
+    if (const std::string why = loaded.frames[k].frames->error(); !why.empty())
+      throw io::IoError(loaded.inputs[k]->source(), "", "a frame could not be read: " + why);
+  require_valid(rig);
+  return rig;
+}
+
+io::ResultDocument rig_entries(const RigCalibration& rig, std::size_t frame_index,
+                               const std::optional<Selection>& selection, double budget_s) {
   io::ResultDocument doc;
   for (const RigTarget& t : rig.targets)
-    doc.results.push_back(rig_entry(t, rig.base_name, frame_index));
+    doc.results.push_back(rig_entry(t, rig.base_name, frame_index, selection, budget_s));
   for (const RigCycle& c : rig.cycles) doc.cycles.push_back(cycle_entry(c, rig.base_name));
   return doc;
 }

@@ -74,14 +74,17 @@
 
 namespace hots {
 
+/// The share of refine done after each of its phases, for a progress bar: the phases' shares of
+/// HOTS's time on the 60 s 64-32 drive (docs/experiments/long_drives.md: prepare 6 %, hierarchy
+/// 35 %, cross links 27 %, graph and synchronisation 1 %, whole-sequence step 31 %).
+using RefineProgress = std::function<void(double share)>;
+
 /// See the header comment. a and b are LidarSequences with their odometry poses; S is the
-/// scalar of the prepared point clouds (float is plenty).
-/// progress(fraction) is called on the calling thread after each of its six phases (preparation,
-/// hierarchies, cross links, graph, solve, sequence step), with the phases done over six.
+/// scalar of the prepared point clouds (float is plenty). progress (optional) is called on the
+/// calling thread after each phase.
 template <typename S = float, class SeqA, class SeqB>
 RefineResult refine(const SeqA& a, const SeqB& b, const Isometry3d& extrinsic,
-                    const RefineOptions& options = {},
-                    const std::function<void(double)>& progress = {}) {
+                    const RefineOptions& options = {}, const RefineProgress& progress = {}) {
   namespace d = hots_detail;
   RefineResult result;
   result.extrinsic = extrinsic;
@@ -93,29 +96,29 @@ RefineResult refine(const SeqA& a, const SeqB& b, const Isometry3d& extrinsic,
     result.reason = why;
     return result;
   };
-  auto phase_done = [&progress](int phase) {
-    if (progress) progress(phase / 6.0);
-  };
   if (const char* why = d::input_problem(a, b, extrinsic, options))
     return fail(RefineStatus::invalid_input, why);
   RefineStatistics& st = result.statistics;
   d::RefineState<S> s(a, b);
   s.mapa_mapb = d::map_b_in_map_a(s.a, s.b, extrinsic, options.time_offset_s);
+  auto done = [&progress](double share) {
+    if (progress) progress(share);
+  };
   d::prepare_lidars(a, b, s, options, st);
-  phase_done(1);
+  done(0.06);
   d::build_hierarchies(s, options, st);
-  phase_done(2);
-  if (!d::link_lidars(s, options.time_offset_s, options, st))
+  done(0.41);
+  const bool linked = d::link_lidars(s, options.time_offset_s, options, st);
+  done(0.68);
+  if (!linked)
     return fail(RefineStatus::extrinsic_unconfirmed,
                 "too few of the cross links (b's submaps registered to a's through the "
                 "extrinsic) agree with it: the two LiDARs' views do not confirm the extrinsic "
                 "(statistics: cross_links_agreeing of cross_links_attempted)");
-  phase_done(3);
   d::build_graph(s, extrinsic, options, st);
-  phase_done(4);
   if (const RefineStatus status = d::solve_passes(s, options, result); status != RefineStatus::ok)
     return fail(status, result.reason);
-  phase_done(5);
+  done(0.69);
   if (options.sequence.enabled && !d::sequence_step(s, options, result))
     return fail(RefineStatus::sequence_failed, result.reason);
   d::output_poses(s, result);

@@ -65,12 +65,13 @@ std::vector<std::vector<ulc::Vec3<S>>> prepare_frames(const Frames& frames, cons
         for (std::size_t k = r.begin(); k != r.end(); ++k) {
           if (k % stride != 0) continue;
           const std::pair<Isometry3d, double> motion = sweep(k);
-          auto deskewed = ulc::deskew(frames[k], motion.first, motion.second);
-          const bool timed = sweeps && ulc::traits::has_time(frames[k]) && motion.second > 0.0;
+          const auto& frame = frames[k];  // once: a FrameSource reads it on each access
+          auto deskewed = ulc::deskew(frame, motion.first, motion.second);
+          const bool timed = sweeps && ulc::traits::has_time(frame) && motion.second > 0.0;
           if (timed) {
             deskewed.times.resize(deskewed.points.size());
             for (std::size_t i = 0; i < deskewed.points.size(); ++i)
-              deskewed.times[i] = ulc::traits::time(frames[k], i);
+              deskewed.times[i] = ulc::traits::time(frame, i);
           }
           const auto down = ulc::voxel_downsample(deskewed, voxel);
           const auto& cloud = down.ok() ? down.cloud : deskewed;

@@ -272,7 +272,7 @@ StageOutcome hots_step(const AttemptInputs<FA, FB>& in, Attempt& at) {
   b.poses = odo.poses_b;
   t0 = std::chrono::steady_clock::now();
   const hots::RefineResult h = hots::refine(
-      a, b, at.extrinsic, in.hots, [&](double f) { notify(in.options, hots_stage, f); });
+      a, b, at.extrinsic, in.hots, [&](double share) { notify(in.options, hots_stage, share); });
   at.out.timing_s.hots = seconds_since(t0);
   add_refine(*at.out.hots, h, at.out.timing_s.hots);
   at.out.hots->time_offset_s += at.out.time_offset_s;  // back to b's own clock

@@ -18,6 +18,7 @@
 
 #include "pipeline/options.hpp"
 #include "pipeline/pair_calibration.hpp"
+#include "ulc/core/frame_source.hpp"
 #include "ulc/core/point_cloud.hpp"
 #include "ulc/core/point_traits.hpp"
 
@@ -29,6 +30,13 @@ using FloatFrames = std::vector<PointCloud<float>>;
 /// The pipeline on PointCloud<float> frames (defined in pipeline/implementation.hpp).
 PairCalibration calibrate_pair(const FloatFrames& frames_a, const std::vector<double>& times_a,
                                const FloatFrames& frames_b, const std::vector<double>& times_b,
+                               const CalibrateOptions& options = {});
+
+/// The pipeline on frames read on demand (ulc/core/frame_source.hpp): no stage holds a whole
+/// drive's raw frames. The result is the same as on the same frames held in memory. A frame that
+/// could not be read reaches the stages empty: check each source's error() after the call.
+PairCalibration calibrate_pair(const FrameSource& frames_a, const std::vector<double>& times_a,
+                               const FrameSource& frames_b, const std::vector<double>& times_b,
                                const CalibrateOptions& options = {});
 
 /// Any traits cloud as a PointCloud<float>: points, and per-point times and intensities when the
@@ -72,7 +80,9 @@ const FloatFrames& float_frames(const Frames& frames, FloatFrames& storage) {
 
 /// The pipeline on frames of any traits cloud type (random-access containers of clouds, one
 /// timestamp per frame), adapted once to PointCloud<float>.
-template <class FramesA, class FramesB>
+template <class FramesA, class FramesB,
+          class = std::enable_if_t<!std::is_base_of_v<FrameSource, FramesA> &&
+                                   !std::is_base_of_v<FrameSource, FramesB>>>
 PairCalibration calibrate_pair(const FramesA& frames_a, const std::vector<double>& times_a,
                                const FramesB& frames_b, const std::vector<double>& times_b,
                                const CalibrateOptions& options = {}) {

@@ -22,4 +22,15 @@ PairCalibration calibrate_pair(const FloatFrames& frames_a, const std::vector<do
   return r;
 }
 
+PairCalibration calibrate_pair(const FrameSource& frames_a, const std::vector<double>& times_a,
+                               const FrameSource& frames_b, const std::vector<double>& times_b,
+                               const CalibrateOptions& options) {
+  const TimedSource a(frames_a, times_a, options.frame_index);
+  const TimedSource b(frames_b, times_b, options.frame_index);
+  PairCalibration r = calibrate_pair_in_place(a, times_a, b, times_b, options);
+  report_point_times(a.summary(), r.point_times_base);
+  report_point_times(b.summary(), r.point_times_target);
+  return r;
+}
+
 }  // namespace ulc

@@ -46,7 +46,7 @@
 //     registration) is judged; a direction it leaves free makes the status degenerate, over
 //     ok or a stage's failure, and `unobservable` names it.
 //   - Progress: options.progress(stage, fraction in [0, 1]) on the calling thread; stages
-//     "terra", "jeep", "odometry", "hots" (HOTS after each of its six phases); a later hypothesis's
+//     "terra", "jeep", "odometry", "hots" (HOTS after each of its phases); a later hypothesis's
 //     stages carry " (hypothesis k)".
 //   - Threads: every stage is deterministic for any thread count, so is this.
 //     CalibrateOptions::threads runs the call in a tbb::task_arena of that size.
@@ -58,6 +58,7 @@
 #include <cstddef>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -66,6 +67,7 @@
 #include "pipeline/attempt.hpp"
 #include "pipeline/options.hpp"
 #include "pipeline/pair_calibration.hpp"
+#include "pipeline/point_times.hpp"
 #include "pipeline/stages.hpp"
 #include "pipeline/terra_stage.hpp"
 #include "pipeline/vouch.hpp"
@@ -227,6 +229,32 @@ PairCalibration try_hypotheses(const AttemptInputs<FA, FB>& in, const StartRotat
                     " hypotheses were not confirmed either (stages.terra.hypotheses)");
 }
 
+/// The frames' point-time report before the stages: frames read on demand are counted as the
+/// stages read them instead (a pass of its own would read the whole drive once more).
+template <class Frames>
+PointTimesReport point_times_before(const FrameRange<Frames>& frames) {
+  if constexpr (std::is_base_of_v<FrameSource, Frames>)
+    return {};
+  else
+    return point_times_of(frames);
+}
+
+/// The point times of frames read on demand, as the stages met them (point_times.hpp).
+template <class FA, class FB>
+void point_times_read(const AttemptInputs<FA, FB>& in, PairCalibration& r) {
+  if constexpr (std::is_base_of_v<TimedSource, FA>)
+    r.point_times_base = in.a.frames.container().untimed_report();
+  if constexpr (std::is_base_of_v<TimedSource, FB>)
+    r.point_times_target = in.b.frames.container().untimed_report();
+}
+
+/// The vouching on the result (vouch.hpp), with the point times the stages met.
+template <class FA, class FB>
+StageOutcome vouch_read(const AttemptInputs<FA, FB>& in, PairCalibration& r) {
+  point_times_read(in, r);
+  return vouch(in, r);
+}
+
 /// TERRA alone: its best rotation is the answer.
 inline PairCalibration terra_only(const StartRotations& starts, PairCalibration& r,
                                   const Finish& finish) {
@@ -252,13 +280,13 @@ PairCalibration run_pipeline(const FA& frames_a, const std::vector<double>& time
                                  has_stage(options.stages, Stage::terra),
                                  has_stage(options.stages, Stage::jeep),
                                  has_stage(options.stages, Stage::hots)};
-  r.point_times_base = point_times_of(in.a.frames);
-  r.point_times_target = point_times_of(in.b.frames);
+  r.point_times_base = point_times_before(in.a.frames);
+  r.point_times_target = point_times_before(in.b.frames);
   if (!in.run_terra) {
     r.T_base_target = *options.initial;
     const StageOutcome o = run_attempt(in, *options.initial, "", true, r);
     finish(o.status, o.reason);
-    const StageOutcome v = vouch(in, r);
+    const StageOutcome v = vouch_read(in, r);
     return finish(v.status, v.reason);
   }
   const auto starts = terra_step(frames_a, times_a, frames_b, times_b, options, r);
@@ -266,9 +294,12 @@ PairCalibration run_pipeline(const FA& frames_a, const std::vector<double>& time
     return finish(CalibrateStatus::terra_failed,
                   std::string("TERRA: ") + terra::to_string(r.terra->status) + ": " +
                       r.terra->reason + " (on " + to_string(r.terra->source) + ")");
-  if (!in.run_jeep && !in.run_hots) return terra_only(*starts, r, finish);
+  if (!in.run_jeep && !in.run_hots) {
+    point_times_read(in, r);
+    return terra_only(*starts, r, finish);
+  }
   try_hypotheses(in, *starts, r, finish);
-  const StageOutcome v = vouch(in, r);
+  const StageOutcome v = vouch_read(in, r);
   return finish(v.status, v.reason);
 }
 

@@ -5,15 +5,24 @@
 // them). Frames that do carry times are copied as they are. What could not be timed (a Livox
 // pattern, a small-FoV unit, points not in firing order) reaches the pipeline without times,
 // and pipeline/vouch.hpp bounds what that does to the translation.
+//
+// Frames read on demand (ulc/core/frame_source.hpp) go through a TimedSource instead: the first
+// non-empty frame from frame_index decides (has times: every frame is handed over as read;
+// none, and it looks like a sweep: every frame without times gets them from azimuth), and the
+// report counts the frames the stages read, as they read them (no pass of its own over a drive).
 #pragma once
 
+#include <atomic>
 #include <cstddef>
+#include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "odometry/frame_pairing.hpp"
 #include "pipeline/calibrate.hpp"
 #include "pipeline/pair_calibration.hpp"
+#include "ulc/core/frame_source.hpp"
 #include "ulc/core/sweep_times.hpp"
 
 namespace ulc {
@@ -52,6 +61,77 @@ inline void fill_point_times(const FloatFrames& frames, const std::vector<double
   }
   out.frames = &out.storage;
 }
+
+/// A FrameSource with per-point times synthesised where its frames have none (see the top).
+class TimedSource : public FrameSource {
+ public:
+  TimedSource(const FrameSource& frames, const std::vector<double>& times, std::size_t first)
+      : frames_(frames),
+        period_(odometry::frame_period(times)),
+        seen_(std::make_unique<std::atomic<std::uint8_t>[]>(frames.size())) {
+    for (std::size_t k = 0; k < frames.size(); ++k) seen_[k] = kUnseen;
+    for (std::size_t k = first; k < frames.size(); ++k) {
+      const PointCloud<float> cloud = frames.load(k);
+      if (cloud.empty()) continue;
+      if (cloud.has_times()) return;
+      const SweepTimes probe = sweep_times_from_azimuth(cloud, period_);
+      synthesise_ = probe.ok();
+      direction_ = probe.direction;
+      reason_ = probe.reason;
+      return;
+    }
+  }
+
+  std::size_t size() const override { return frames_.size(); }
+
+  PointCloud<float> load(std::size_t i) const override {
+    PointCloud<float> cloud = frames_.load(i);
+    if (cloud.empty() || cloud.has_times()) {
+      seen_[i] = kTimed;
+      return cloud;
+    }
+    SweepTimes t;
+    if (synthesise_) t = sweep_times_from_azimuth(cloud, period_);
+    if (synthesise_ && t.ok()) {
+      cloud.times = std::move(t.times);
+      seen_[i] = kSynthesised;
+    } else {
+      seen_[i] = kUntimed;
+    }
+    return cloud;
+  }
+
+  /// The frames without times among those read, and what was done about them.
+  TimedFrames summary() const {
+    TimedFrames out;
+    for (std::size_t k = 0; k < frames_.size(); ++k) out.synthesised += seen_[k] == kSynthesised;
+    out.direction = direction_;
+    out.reason = reason_;
+    return out;
+  }
+
+  /// The pipeline's report before synthesis (as point_times_of counts it).
+  PointTimesReport untimed_report() const {
+    std::size_t untimed = 0;
+    for (std::size_t k = 0; k < frames_.size(); ++k) untimed += seen_[k] == kUntimed;
+    PointTimesReport r;
+    if (untimed == 0) return r;
+    r.source = PointTimeSource::none;
+    r.frames_without = untimed;
+    r.note = std::to_string(untimed) +
+             " frame(s) carry no per-point time: their sweeps are not deskewed";
+    return r;
+  }
+
+ private:
+  enum : std::uint8_t { kUnseen, kTimed, kUntimed, kSynthesised };
+  const FrameSource& frames_;
+  double period_;
+  bool synthesise_ = false;
+  int direction_ = 0;
+  std::string reason_;
+  std::unique_ptr<std::atomic<std::uint8_t>[]> seen_;
+};
 
 /// The pipeline's point-time report for that LiDAR, with what the entry did.
 inline void report_point_times(const TimedFrames& t, PointTimesReport& r) {

@@ -337,6 +337,20 @@ TEST_CASE("bad input: truncated and corrupted binary frames, a header claiming 2
   check_refused(d.calibrate(ply, "--stages terra"), {ply.string(), huge});
 }
 
+TEST_CASE("bad input: a damaged frame in the middle of a drive is named when the stages meet it",
+          "[app][bad_input]") {
+  // Frames are read when a stage needs them (ulc/core/frame_source.hpp): the odometry meets this
+  // one half-way, and the command refuses the result instead of calibrating without it.
+  const Drive d("ulc_test_bad_middle", "3");
+  const fs::path target = d.copy_of_target("spoiled");
+  const fs::path frame = target / "000015.pcd";
+  auto bytes = bytes_of(frame);
+  bytes.resize(bytes.size() / 2);
+  write_bytes(frame, bytes);
+  check_refused(d.calibrate(target, "--synced-clocks"),
+                {frame.string(), "truncated binary data", "a frame could not be read"});
+}
+
 TEST_CASE("Ctrl-C stops ulc calibrate with exit code 130 and leaves no file behind",
           "[app][interrupt]") {
   const Drive d("ulc_test_interrupt", "4");

@@ -30,13 +30,15 @@ namespace {
 using ulc_test::kUlc;
 constexpr double kDeg = 3.14159265358979323846 / 180.0;
 
-/// A 0.6 s 64-32 drive (six frames per LiDAR) in its own temporary folder, removed afterwards.
+/// A 0.6 s 64-32 drive (six frames per LiDAR; or `seconds`) in its own temporary folder, removed
+/// afterwards.
 struct Dataset {
   fs::path dir;
-  explicit Dataset(const std::string& name) : dir(fs::temp_directory_path() / name) {
+  explicit Dataset(const std::string& name, const std::string& seconds = "0.6")
+      : dir(fs::temp_directory_path() / name) {
     fs::remove_all(dir);
-    const auto run = run_command(kUlc + " simulate --quiet --scenario 64-32 --seconds 0.6 " +
-                                 "--seed 2 --out " + quote(dir.string()));
+    const auto run = run_command(kUlc + " simulate --quiet --scenario 64-32 --seconds " + seconds +
+                                 " --seed 2 --out " + quote(dir.string()));
     INFO(run.output);
     REQUIRE(run.exit_code == 0);
   }
@@ -425,7 +427,8 @@ TEST_CASE("ulc calibrate names a LiDAR without point times and says the offset w
   CHECK(r[0].point_times.at("base").at("source").get<std::string>() == "per_point");
   CHECK(r[0].point_times.at("target").at("source").get<std::string>() ==
         "synthesised_from_azimuth");
-  CHECK(r[0].point_times.at("target").at("frames_without").get<double>() == 6);
+  // Frames are read on demand and counted as the stages read them: JEEP's 5 pairs of the 6.
+  CHECK(r[0].point_times.at("target").at("frames_without").get<double>() == 5);
   CHECK(r[0].clock.at("source").get<std::string>() == "given");
   CHECK(evaluate_success(d, out));
 
@@ -445,4 +448,35 @@ TEST_CASE("ulc calibrate names a LiDAR without point times and says the offset w
                                    "--no-point-times lidar99 --out " + quote(d.file("x")));
   CHECK(unknown.exit_code == 2);
   CHECK_THAT(unknown.output, Catch::Contains("no LiDAR named 'lidar99'"));
+}
+
+TEST_CASE("ulc calibrate --budget calibrates the best stretch of a longer drive and says which",
+          "[app][calibrate][selection]") {
+  const Dataset d("ulc_test_calibrate_budget", "10");
+  const std::string out = d.file("result.json");
+  const auto run = run_command(kUlc + " calibrate" + d.pair_args() +
+                               " --synced-clocks --budget 5 --output " + quote(out));
+  INFO(run.output);
+  REQUIRE(run.exit_code == 0);
+  CHECK_THAT(run.output, Catch::Contains("survey: 100% (100/100)"));  // frames surveyed
+  CHECK_THAT(run.output, Catch::Contains("s left"));                  // the time still to go
+  CHECK_THAT(run.output, Catch::Contains("stretch "));
+  const auto results = ulc::io::read_result_file(out);
+  REQUIRE(results.size() == 1);
+  const auto& sel = results[0].stages.at("selection");
+  CHECK(sel.at("applied").get<bool>());
+  CHECK(sel.at("budget_s").get<double>() == 5.0);
+  CHECK(sel.at("drive_s").get<double>() == Approx(9.9).margin(0.05));
+  const double start = sel.at("start_s").get<double>(), end = sel.at("end_s").get<double>();
+  CHECK(end - start == Approx(5.0));
+  const auto& windows = sel.at("windows");
+  REQUIRE(windows.size() == 2);  // from 0 s, and the last 5 s
+  const auto chosen = sel.at("chosen").get<std::size_t>();
+  REQUIRE(chosen < windows.size());
+  CHECK(windows[chosen].at("start_s").get<double>() == start);
+  for (const auto& w : windows)
+    CHECK(w.at("score").get<double>() <= windows[chosen].at("score").get<double>());
+  // HOTS ran on the stretch alone, and the answer is right.
+  CHECK(results[0].stages.at("hots").at("frames_base").get<double>() <= 51);
+  CHECK(evaluate_success(d, out));
 }

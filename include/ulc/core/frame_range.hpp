@@ -18,6 +18,7 @@ class FrameRange {
 
   std::size_t size() const { return frames_->size() - first_; }
   decltype(auto) operator[](std::size_t i) const { return (*frames_)[first_ + i]; }
+  const Frames& container() const { return *frames_; }
 
  private:
   const Frames* frames_;
