@@ -122,6 +122,11 @@ struct SequenceExtrinsicOptions {
   double source_voxel = 0.8;     ///< m, each target frame's thinning
   double target_voxel = 0.3;     ///< m, each base submap's thinning
   std::size_t frame_stride = 4;  ///< every n-th target frame (2.5 per second at 10 Hz)
+  /// ... but a shorter stride (down to every frame) while the stride would leave fewer frames
+  /// than this: the covariance is a delete-one-frame jackknife, and an estimate of 6 directions
+  /// from G frames is widened by Hotelling's T^2 (ulc/core/small_sample.hpp): 1.95 in variance
+  /// at G = 25, 387 at G = 8 (a 3 s drive at stride 4).
+  std::size_t min_frames = 25;
   ulc::PlaneCloudOptions planes;
   /// Coarse to fine from HOTS's start (millimetres to a few centimetres away).
   std::vector<ulc::RegistrationOptions> stages = default_stages();

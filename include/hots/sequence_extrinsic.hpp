@@ -53,8 +53,9 @@
 //     drives) and g_c the frame's gradient sum w r J (one frame's points share its placement
 //     error: per-point clustering is another 2-4x too small; about 25 frames of a 10 s drive
 //     give each a leverage the plain sandwich A^-1 M A^-1 ignores). With dt solved alongside C
-//     it is the 7x7 jackknife's 6x6 block, so dt's uncertainty widens C's.
-//     Measured in docs/experiments/covariance_coverage.md.
+//     it is the 7x7 jackknife's 6x6 block, so dt's uncertainty widens C's. Widened for its
+//     few frames by Hotelling's T^2 (ulc/core/small_sample.hpp). Measured in
+//     docs/experiments/covariance_coverage.md.
 //   - The result keeps C and dt of the input when the registration fails (status says why).
 //   - Nothing here throws or prints; the same results for any number of threads (per-term
 //     deterministic reductions summed in term order).
@@ -434,7 +435,15 @@ class SequenceProblem {
   ulc::PointToPlaneMatches matches_;
 };
 
-/// Every frame_stride-th frame of b, thinned at source_voxel once: their placement depends on
+/// The stride through b's frames: frame_stride, shortened while it would keep fewer than
+/// min_frames of them.
+inline std::size_t target_stride(std::size_t frames, const SequenceExtrinsicOptions& o) {
+  std::size_t stride = std::max<std::size_t>(o.frame_stride, 1);
+  while (stride > 1 && (frames + stride - 1) / stride < o.min_frames) --stride;
+  return stride;
+}
+
+/// Every target_stride-th frame of b, thinned at source_voxel once: their placement depends on
 /// dt only.
 template <typename S>
 SequenceProblem<S> sequence_problem(const BaseSubmaps<S>& submaps,
@@ -444,8 +453,8 @@ SequenceProblem<S> sequence_problem(const BaseSubmaps<S>& submaps,
                                     const std::vector<double>& times_b, double dt0,
                                     const SequenceExtrinsicOptions& o) {
   std::vector<std::size_t> used;
-  for (std::size_t j = 0; j < frames_b.size(); j += std::max<std::size_t>(o.frame_stride, 1))
-    used.push_back(j);
+  const std::size_t stride = target_stride(frames_b.size(), o);
+  for (std::size_t j = 0; j < frames_b.size(); j += stride) used.push_back(j);
   std::vector<std::vector<ulc::Vec3<S>>> sources(used.size());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, used.size(), 1),
                     [&](const tbb::blocked_range<std::size_t>& r) {
@@ -583,10 +592,13 @@ std::optional<Mat6d> extrinsic_covariance(SequenceProblem<S>& problem, const Sol
     frames.add(frame, Mat7(stage.kernel.curvature(r) * J * J.transpose()),
                Vec7((stage.kernel.weight(r) * r) * J));
   });
-  if (!with_time) return frames.covariance<6>();
+  if (!with_time) return frames.widened_covariance<6>();
+  // C's marginal of the 7x7 estimate, widened as a 6-dimensional T^2 with the same G - 1
+  // degrees of freedom.
   const auto c = frames.covariance<7>();
-  if (!c) return std::nullopt;
-  return Mat6d(c->topLeftCorner<6, 6>());
+  const auto k = ulc::small_sample_scale(6, static_cast<double>(frames.clusters()));
+  if (!c || !k) return std::nullopt;
+  return Mat6d(*k * c->topLeftCorner<6, 6>());
 }
 
 /// The solve's answer and statistics into the result.

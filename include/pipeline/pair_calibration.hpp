@@ -45,7 +45,10 @@ enum class CalibrateStatus {
   /// The final problem leaves a direction of the extrinsic free (a straight road, a tunnel):
   /// `unobservable` names it; the extrinsic's other directions are the data's
   /// (pipeline/observability_verdict.hpp).
-  degenerate
+  degenerate,
+  /// The result's own covariance does not vouch for it: more than a 5 % chance of lying beyond
+  /// a success's 1 deg / 10 cm along some direction (pipeline/confidence.hpp; extrinsic kept).
+  uncertain
 };
 
 inline const char* to_string(CalibrateStatus s) {
@@ -66,6 +69,8 @@ inline const char* to_string(CalibrateStatus s) {
       return "point_times_missing";
     case CalibrateStatus::degenerate:
       return "degenerate";
+    case CalibrateStatus::uncertain:
+      return "uncertain";
     default:
       return "hots_failed";
   }

@@ -18,6 +18,8 @@
 //     that bound exceeds max_translation_effect_m, status point_times_missing. (The compiled
 //     entry, calibrate_pair, first synthesises times from azimuth for spinning LiDARs:
 //     pipeline/point_times.hpp; what it could not time is what reaches this check.)
+//   - A covariance wider than a success allows: more than a 5 % chance of lying beyond 10 cm or
+//     1 deg along some direction, status uncertain (confidence.hpp).
 //   Every result whose translation JEEP or HOTS made has a ClockReport (PairCalibration::clock)
 //   saying where the offset came from and, when not estimated, how far 1 ms moves the answer.
 #pragma once
@@ -29,11 +31,13 @@
 #include <string>
 #include <tuple>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "odometry/frame_pairing.hpp"
 #include "odometry/run_odometry.hpp"
 #include "pipeline/attempt.hpp"
+#include "pipeline/confidence.hpp"
 #include "pipeline/motion_lag.hpp"
 #include "pipeline/pair_calibration.hpp"
 #include "ulc/core/point_traits.hpp"
@@ -210,6 +214,8 @@ StageOutcome vouch(const AttemptInputs<FA, FB>& in, PairCalibration& r) {
                 "; run HOTS (--stages terra,jeep,hots) or give the offset (--synced-clocks, "
                 "--time-offset S)",
             false};
+  if (std::string why = loosely_pinned(r, v); !why.empty())
+    return {CalibrateStatus::uncertain, std::move(why), false};
   return kept;
 }
 

@@ -1,5 +1,6 @@
 // The options of the checks on what the data cannot vouch for (pipeline/vouch.hpp): a clock
-// offset nobody estimated, and frames without per-point times. Light: no algorithm.
+// offset nobody estimated, frames without per-point times, and a covariance wider than a
+// success allows (pipeline/confidence.hpp). Light: no algorithm.
 #pragma once
 
 #include <cstddef>
@@ -35,6 +36,12 @@ struct VouchOptions {
   /// The lag counts as bounded when (|lag| + sigma_factor * sigma) * speed is within
   /// max_translation_effect_m.
   double sigma_factor = 3.0;
+  /// A HOTS success whose covariance gives it more than max_beyond_probability of lying beyond
+  /// a success's own bars along its loosest direction becomes `uncertain`
+  /// (pipeline/confidence.hpp).
+  double success_translation_m = 0.10;
+  double success_rotation_deg = 1.0;
+  double max_beyond_probability = 0.05;
   bool enabled = true;  ///< false: no check (the result still says the offset was not estimated)
 };
 

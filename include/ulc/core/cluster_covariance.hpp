@@ -19,7 +19,9 @@
 // the share of cluster c,
 //   cov(x) = (G - 1) / G * sum_c d_c d_c^T,   d_c = (A - A_c)^-1 g_c,
 // d_c being the one-step change of the estimate when cluster c is left out
-// (ClusterJackknife; measured in docs/experiments/covariance_coverage.md).
+// (ClusterJackknife; measured in docs/experiments/covariance_coverage.md). An estimate from G
+// clusters is itself uncertain: the ellipsoids it draws hold their probability only once
+// widened by Hotelling's T^2 against chi-square (widened_covariance, ulc/core/small_sample.hpp).
 //
 // Conventions this header owns:
 //   - N parameters (6 for an extrinsic [rho; phi], 7 with a clock offset); H symmetric.
@@ -39,6 +41,7 @@
 #include <Eigen/Core>
 #include <Eigen/LU>
 
+#include "ulc/core/small_sample.hpp"
 #include "ulc/core/types.hpp"
 
 namespace ulc {
@@ -106,6 +109,19 @@ class ClusterJackknife {
     }
     cov = ((G - 1.0) / G * 0.5 * (cov + cov.transpose())).eval();
     if (!cov.allFinite()) return std::nullopt;
+    return cov;
+  }
+
+  /// covariance<M>() widened for its few clusters by small_sample_scale(M, G)
+  /// (ulc/core/small_sample.hpp: Hotelling's T^2 against chi-square at the 3-sigma level), so
+  /// that its 3-sigma ellipsoid keeps its probability; the covariance a result reports. nullopt
+  /// also when G - 1 < M (too few clusters to estimate M directions).
+  template <int M = N>
+  std::optional<Eigen::Matrix<double, M, M>> widened_covariance() const {
+    const std::optional<double> k = small_sample_scale(M, static_cast<double>(sums_.size()));
+    if (!k) return std::nullopt;
+    auto cov = covariance<M>();
+    if (cov) *cov *= *k;
     return cov;
   }
 

@@ -51,7 +51,7 @@ std::optional<Mat6d> point_to_plane_covariance(
                    Vec6d((w * r) * J));
     }
   }
-  return clusters.covariance();
+  return clusters.widened_covariance();
 }
 
 /// The same for one source cloud against one target (T = T_target_source).
