@@ -8,7 +8,7 @@
 // a sideways Bpearl 0.5 mm from the truth; HOTS's graph moved it 9 cm along the drive and its
 // whole-sequence step another 19 cm, every check of HOTS passing, status ok 28 cm off. The
 // covariance, which carries the whole-sequence step's move from the graph's answer
-// (hots/refine_steps.hpp), gave 19 cm of sigma along x: a 60 % chance of being 10 cm off.
+// (hots/refine_steps.hpp), gave 19 cm of sigma along x: a 59 % chance of being 10 cm off.
 //
 // Conventions this header owns:
 //   - Only HOTS's successes with a covariance are judged: their covariance is the frame
