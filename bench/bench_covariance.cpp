@@ -38,6 +38,7 @@
 #include "support/bench_util.hpp"
 #include "ulc/core/lie.hpp"
 #include "ulc/core/pose_error.hpp"
+#include "ulc/core/small_sample.hpp"
 #include "ulc/sim/simulate.hpp"
 
 namespace {
@@ -56,18 +57,6 @@ struct Config {
   int threads = 2;
   ulc_bench::Options bench;
 };
-
-/// The chi-square(6) quantile at 99.73 %: 1 - CDF(x) = exp(-x/2) (1 + x/2 + x^2/8), by
-/// bisection.
-double chi2_6_quantile(double p) {
-  double lo = 0.0, hi = 200.0;
-  for (int i = 0; i < 200; ++i) {
-    const double x = 0.5 * (lo + hi), y = 0.5 * x;
-    const double tail = std::exp(-y) * (1.0 + y + 0.5 * y * y);
-    (1.0 - tail < p ? lo : hi) = x;
-  }
-  return 0.5 * (lo + hi);
-}
 
 /// One calibrated pair: its errors and d^2 (negative: no covariance).
 struct Outcome {
@@ -190,7 +179,7 @@ struct Tally {
 };
 
 void bench(const Config& c) {
-  const double limit = chi2_6_quantile(0.9973);
+  const double limit = ulc::chi_square_quantile(ulc::kThreeSigmaLevel, 6);
   ulc_bench::Table table({"scenario", "runs", "successes", "false_successes", "uncertain",
                           "uncertain_right", "with_covariance", "coverage_3sigma_pct",
                           "median_normalised_error", "median_e_rot_deg", "median_e_trans_cm"});

@@ -5,6 +5,8 @@
 
 #include <cstddef>
 
+#include "ulc/core/pose_error.hpp"
+
 namespace ulc {
 
 /// The lag search of motion_lag.hpp.
@@ -39,8 +41,8 @@ struct VouchOptions {
   /// A HOTS success whose covariance gives it more than max_beyond_probability of lying beyond
   /// a success's own bars along its loosest direction becomes `uncertain`
   /// (pipeline/confidence.hpp).
-  double success_translation_m = 0.10;
-  double success_rotation_deg = 1.0;
+  double success_translation_m = kCalibrationMaxTranslationM;
+  double success_rotation_deg = kCalibrationMaxRotationDeg;
   double max_beyond_probability = 0.05;
   bool enabled = true;  ///< false: no check (the result still says the offset was not estimated)
 };
