@@ -23,9 +23,9 @@
 //   - The chance is that of the loosest direction alone: sigma = sqrt of the largest eigenvalue
 //     of the translation block (m) or the rotation block (rad) of covariance_6x6 ([rho; phi],
 //     left), P(|x| > bar) for x ~ N(0, sigma^2); above VouchOptions::max_beyond_probability (5 %,
-//     sigma beyond bar / 1.96) the result is uncertain. A 3-sigma rule (0.27 %) was tried first:
-//     on the held-out seeds 11-20 of horizon-tele (10 s) it refused 2 of the 4 right answers,
-//     whose narrow view pins x to a sigma of 3-5 cm (bench_covariance).
+//     sigma beyond bar / 1.96) the result is uncertain. A 3-sigma rule (0.27 %) would refuse
+//     2 of the 4 right horizon-tele answers on seeds 11-20 (10 s), whose narrow view pins x to
+//     a sigma of 3-5 cm (docs/experiments/covariance_coverage.md).
 #pragma once
 
 #include <algorithm>
