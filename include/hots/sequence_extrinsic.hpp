@@ -592,13 +592,9 @@ std::optional<Mat6d> extrinsic_covariance(SequenceProblem<S>& problem, const Sol
     frames.add(frame, Mat7(stage.kernel.curvature(r) * J * J.transpose()),
                Vec7((stage.kernel.weight(r) * r) * J));
   });
-  if (!with_time) return frames.widened_covariance<6>();
-  // C's marginal of the 7x7 estimate, widened as a 6-dimensional T^2 with the same G - 1
-  // degrees of freedom.
-  const auto c = frames.covariance<7>();
-  const auto k = ulc::small_sample_scale(6, static_cast<double>(frames.clusters()));
-  if (!c || !k) return std::nullopt;
-  return Mat6d(*k * c->topLeftCorner<6, 6>());
+  // With dt: C's marginal of the 7x7 estimate, widened as a 6-dimensional T^2 with the same
+  // G - 1 degrees of freedom.
+  return with_time ? frames.widened_marginal<6, 7>() : frames.widened_covariance<6>();
 }
 
 /// The solve's answer and statistics into the result.

@@ -75,4 +75,14 @@ TEST_CASE("a jackknife's widened covariance is its covariance times the scale of
   REQUIRE(plain);
   REQUIRE(wide);
   CHECK(wide->isApprox(*ulc::small_sample_scale(2, 12.0) * *plain));
+  // A marginal: the leading parameter's block of the two-parameter jackknife, widened as one
+  // direction.
+  const auto marginal = enough.widened_marginal<1, 2>();
+  REQUIRE(marginal);
+  CHECK((*marginal)(0, 0) == Approx(*ulc::small_sample_scale(1, 12.0) * (*plain)(0, 0)));
+  // Two clusters estimate one direction (G - 1 = 1), so the marginal exists where the whole
+  // two-parameter covariance does not.
+  REQUIRE(few.widened_marginal<1, 2>());
+  CHECK((*few.widened_marginal<1, 2>())(0, 0) ==
+        Approx(*ulc::small_sample_scale(1, 2.0) * (*few.covariance())(0, 0)));
 }

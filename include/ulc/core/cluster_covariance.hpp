@@ -112,17 +112,25 @@ class ClusterJackknife {
     return cov;
   }
 
-  /// covariance<M>() widened for its few clusters by small_sample_scale(M, G)
+  /// The leading M x M block of covariance<P>() (the marginal of M parameters of the problem in
+  /// the leading P, the rest held), widened for its few clusters by small_sample_scale(M, G)
   /// (ulc/core/small_sample.hpp: Hotelling's T^2 against chi-square at the 3-sigma level), so
   /// that its 3-sigma ellipsoid keeps its probability; the covariance a result reports. nullopt
   /// also when G - 1 < M (too few clusters to estimate M directions).
-  template <int M = N>
-  std::optional<Eigen::Matrix<double, M, M>> widened_covariance() const {
+  template <int M, int P = M>
+  std::optional<Eigen::Matrix<double, M, M>> widened_marginal() const {
+    static_assert(M <= P && P <= N, "a marginal of the leading P <= N parameters");
     const std::optional<double> k = small_sample_scale(M, static_cast<double>(sums_.size()));
     if (!k) return std::nullopt;
-    auto cov = covariance<M>();
-    if (cov) *cov *= *k;
-    return cov;
+    const auto cov = covariance<P>();
+    if (!cov) return std::nullopt;
+    return Eigen::Matrix<double, M, M>(*k * cov->template topLeftCorner<M, M>());
+  }
+
+  /// covariance<M>() widened for its few clusters (widened_marginal with nothing marginalised).
+  template <int M = N>
+  std::optional<Eigen::Matrix<double, M, M>> widened_covariance() const {
+    return widened_marginal<M, M>();
   }
 
  private:
