@@ -20,7 +20,8 @@
 //   - Submap clouds are voxel-downsampled (submap_voxel) to bound the upper layers' work.
 //   - The top layer's windows share no member: boundary_bridges.hpp can tie them afterwards
 //     (one more BA per boundary, over the members on both sides).
-//   - Continuous-time layer 0 (optional: the caller passes each frame's SweepParts): the
+//   - Continuous-time layer 0 (optional: the caller passes each frame's SweepParts, views into
+//     the frame's points, which hold them part after part: ulc/core/point_span.hpp): the
 //     window's BA is sweep_ba.hpp's, whose variables are the members' poses plus, with
 //     end_knot and a next frame, that frame's pose (where the last sweep ends); the submap
 //     places each part at its own pose. The next frame's estimate is dropped, or kept as one
@@ -41,15 +42,17 @@
 #include "hots/sweep_ba.hpp"
 #include "hots/window_ba.hpp"
 #include "ulc/core/point_cloud.hpp"
+#include "ulc/core/point_span.hpp"
 #include "ulc/core/voxel_downsample.hpp"
 
 namespace hots {
 
-/// One frame's sweep for a continuous-time layer 0: its points in parts by time, each part's
-/// mean fraction of the frame period, and the motion the points were deskewed with.
+/// One frame's sweep for a continuous-time layer 0: its points in parts by time (views into the
+/// frame's points, which must outlive them), each part's mean fraction of the frame period, and
+/// the motion the points were deskewed with.
 template <typename S>
 struct SweepParts {
-  std::vector<std::vector<ulc::Vec3<S>>> parts;
+  std::vector<ulc::PointSpan<S>> parts;
   std::vector<double> fraction;
   Isometry3d deskew = Isometry3d::Identity();
 };
@@ -107,10 +110,9 @@ inline std::vector<Mat6d> marginal_information(const WindowBaResult& ba, double 
 /// The sweep window of layer-0 frames [first, last): every non-empty part of their sweeps,
 /// and the next frame as the last sweep's end knot when asked for and there is one.
 template <typename S>
-SweepWindow<std::vector<ulc::Vec3<S>>> sweep_window(const std::vector<SweepParts<S>>& sweeps,
-                                                    std::size_t first, std::size_t last,
-                                                    bool end_knot) {
-  SweepWindow<std::vector<ulc::Vec3<S>>> sw;
+SweepWindow<ulc::PointSpan<S>> sweep_window(const std::vector<SweepParts<S>>& sweeps,
+                                            std::size_t first, std::size_t last, bool end_knot) {
+  SweepWindow<ulc::PointSpan<S>> sw;
   for (std::size_t m = first; m < last; ++m) {
     const SweepParts<S>& sp = sweeps[m];
     sw.deskew.push_back(sp.deskew);
@@ -169,7 +171,8 @@ HierarchyResult<S> build_hierarchy(const std::vector<std::vector<ulc::Vec3<S>>>&
             Outcome& o = outcomes[k];
             // The submap is made of entries: the members, or at a continuous layer 0 the
             // parts of their sweeps (entry_member: each entry's member).
-            std::vector<const Cloud*> entries = clouds;
+            std::vector<ulc::PointSpan<S>> entries;
+            for (const Cloud* c : clouds) entries.emplace_back(*c);
             std::vector<std::size_t> entry_member(clouds.size());
             for (std::size_t m = 0; m < clouds.size(); ++m) entry_member[m] = m;
             std::vector<Isometry3d> entry_poses;
@@ -177,14 +180,15 @@ HierarchyResult<S> build_hierarchy(const std::vector<std::vector<ulc::Vec3<S>>>&
               o.ran = true;
               std::size_t knots = clouds.size();
               if (l == 0 && sweeps) {
-                const SweepWindow<Cloud> sw =
+                const SweepWindow<ulc::PointSpan<S>> sw =
                     hierarchy_detail::sweep_window(*sweeps, first, last, options.end_knot);
                 std::vector<Isometry3d> knot_poses = member_poses;
                 if (sw.deskew.size() > clouds.size()) knot_poses.push_back(out.poses[last]);
                 knots = knot_poses.size();
                 SweepBaResult sr = sweep_window_ba(sw, knot_poses, options.ba);
                 o.ba = std::move(sr.ba);
-                entries = sw.clouds;
+                entries.clear();
+                for (const ulc::PointSpan<S>* part : sw.clouds) entries.push_back(*part);
                 entry_member = sw.sweep;
                 entry_poses = std::move(sr.entry_poses);
               } else {
@@ -221,7 +225,7 @@ HierarchyResult<S> build_hierarchy(const std::vector<std::vector<ulc::Vec3<S>>>&
             Cloud merged;
             for (std::size_t e = 0; e < entries.size(); ++e) {
               const Isometry3d T = first_inv * entry_poses[e];
-              for (const auto& p : *entries[e])
+              for (const auto& p : entries[e])
                 merged.push_back((T * p.template cast<double>()).template cast<S>());
             }
             o.submap.begin = layer[first].begin;

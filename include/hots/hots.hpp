@@ -41,9 +41,11 @@
 //     left, base frame; m, rad) = the whole-sequence step's jackknife covariance of C
 //     (sequence_extrinsic.hpp) plus delta delta^T, delta = log(C_start C^-1) the step's move from
 //     the graph's or the synchronisation's C: two models of the same data, whose disagreement is
-//     the one sample the result has of an error every frame shares (refine_steps.hpp,
-//     sequence_step). With that step disabled or singular: the spread of the per-pair
-//     extrinsics, or without synchronisation the graph's marginal covariance of C.
+//     a sample of an error every frame shares (refine_steps.hpp, sequence_step). When refine's
+//     own start lies beyond that covariance's 3-sigma ellipsoid, the step runs again from it and
+//     the two answers' difference is added the same way (rerun_from_start). With that step disabled
+//     or singular: the spread of the per-pair extrinsics, or without synchronisation the graph's
+//     marginal covariance of C.
 //   - refined poses are returned in the input map frames (b's through T_mapa_mapb).
 //   - With time synchronisation on, the whole-sequence step checks that the drive pins the
 //     clock offset down (sequence_extrinsic.hpp, check_time_offset); when it does not, the
@@ -100,6 +102,7 @@ RefineResult refine(const SeqA& a, const SeqB& b, const Isometry3d& extrinsic,
     return fail(RefineStatus::invalid_input, why);
   RefineStatistics& st = result.statistics;
   d::RefineState<S> s(a, b);
+  s.start = extrinsic;
   s.mapa_mapb = d::map_b_in_map_a(s.a, s.b, extrinsic, options.time_offset_s);
   auto done = [&progress](double share) {
     if (progress) progress(share);

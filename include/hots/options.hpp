@@ -74,7 +74,8 @@ struct HierarchyOptions {
   /// Parts per sweep for the continuous-time layer 0 (refine() splits the frames); 1: rigid.
   /// Two by default: on the 60 s 64-32 drives the sweeps lower HOTS's trajectory error
   /// (docs/experiments/continuous_time_sweeps.md; current figures: docs/BENCHMARKS.md, "Sweeps
-  /// and bridges by default") for +0.5 GB (the parts are a second copy of the frames).
+  /// and bridges by default"). The parts are views into the thinned frames (point_span.hpp),
+  /// not a copy of them.
   int sweep_parts = 2;
 };
 

@@ -118,7 +118,9 @@ struct RefineStatistics {
   double sync_time_offset_s = 0.0;                      ///< dt of the time synchronisation
   bool sync_significant = false;                        ///< its minimum passed the test
   SequenceExtrinsicResult sequence;                     ///< the last step (status disabled: off)
-  double sequence_seconds = 0.0;                        ///< its wall time (statistics only)
+  /// The step rerun from refine's start (refine_steps.hpp, rerun_from_start; disabled: not run).
+  SequenceExtrinsicResult sequence_rerun;
+  double sequence_seconds = 0.0;  ///< its wall time (statistics only)
   /// Wall time of each phase, s (statistics only: where the stage spends its time).
   double prepare_seconds = 0.0, hierarchy_seconds = 0.0, links_seconds = 0.0;
   double graph_seconds = 0.0, sync_seconds = 0.0;

@@ -163,6 +163,10 @@ inline Json hots_to_json(const HotsReport& h) {
   j["frames_target"] = h.frames_target;
   j["initial_T_base_target"] = matrix_to_json(h.initial.matrix());
   j["graph_T_base_target"] = matrix_to_json(s.graph_extrinsic.matrix());
+  // The whole-sequence step rerun from HOTS's start when the start lay beyond its answer's
+  // 3-sigma ellipsoid (hots/refine_steps.hpp, rerun_from_start); null when it did not run.
+  j["rerun_T_base_target"] =
+      s.sequence_rerun.ok() ? matrix_to_json(s.sequence_rerun.extrinsic.matrix()) : Json();
   j["windows"] = s.windows;
   j["failed_windows"] = s.failed_windows;
   j["planes"] = s.planes;
