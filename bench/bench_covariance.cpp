@@ -31,12 +31,12 @@
 #include <string>
 #include <vector>
 
-#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 
 #include "pipeline/calibrate.hpp"
 #include "support/bench_util.hpp"
 #include "ulc/core/lie.hpp"
+#include "ulc/core/mahalanobis.hpp"
 #include "ulc/core/pose_error.hpp"
 #include "ulc/core/small_sample.hpp"
 #include "ulc/sim/simulate.hpp"
@@ -67,13 +67,6 @@ struct Outcome {
   double rotation_deg = 0.0, translation_m = 0.0;
 };
 
-/// d^2 = xi^T Sigma^-1 xi; negative when Sigma is not positive definite.
-double mahalanobis_sq(const ulc::Vec6d& xi, const ulc::Mat6d& sigma) {
-  const Eigen::LDLT<ulc::Mat6d> ldlt(sigma);
-  if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0.0)) return -1.0;
-  return xi.dot(ldlt.solve(xi));
-}
-
 ulc::sim::Dataset simulate(const std::string& scenario, std::uint64_t seed, const Config& c) {
   ulc::sim::SimulationOptions o;
   o.seed = seed;
@@ -101,7 +94,7 @@ Outcome calibrate(const ulc::sim::Dataset& d, const ulc::sim::PairTruth& truth, 
   out.translation_m = e.translation_m;
   if (r.success && r.covariance_6x6) {
     const ulc::Vec6d xi = ulc::se3_log(Isometry3d(truth.T_base_target * r.T_base_target.inverse()));
-    out.d2 = mahalanobis_sq(xi, *r.covariance_6x6);
+    out.d2 = ulc::mahalanobis_sq(xi, *r.covariance_6x6).value_or(-1.0);
   }
   if (!c.bench.json)
     std::cerr << "  " << d.scenario << " seed " << d.seed << " " << truth.target << ": "

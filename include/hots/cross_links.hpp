@@ -30,17 +30,16 @@
 //     order. Nothing here throws or prints.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <optional>
 #include <utility>
 #include <vector>
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include "hots/hierarchy.hpp"
 #include "hots/options.hpp"
+#include "ulc/core/batched_for.hpp"
 #include "ulc/core/point_to_plane.hpp"
 #include "ulc/core/registration_target.hpp"
 #include "ulc/core/voxel_downsample.hpp"
@@ -69,6 +68,15 @@ inline std::size_t nearest(const std::vector<double>& member_times, double t) {
   for (std::size_t i = 1; i < member_times.size(); ++i)
     if (std::abs(member_times[i] - t) < std::abs(member_times[best] - t)) best = i;
   return best;
+}
+
+/// The members of a's layer l that get a link: every one, or every layer0_stride-th at layer 0.
+inline std::vector<std::size_t> chosen_members(std::size_t members, std::size_t l,
+                                               const CrossLinkOptions& options) {
+  const std::size_t stride = l == 0 ? std::max<std::size_t>(options.layer0_stride, 1) : 1;
+  std::vector<std::size_t> chosen;
+  for (std::size_t i = 0; i < members; i += stride) chosen.push_back(i);
+  return chosen;
 }
 
 /// The cloud voxel-downsampled into `storage` when voxel > 0 and that works; else the cloud.
@@ -112,53 +120,62 @@ std::optional<CrossLink> register_clouds(const std::vector<ulc::Vec3<S>>& target
   return link;
 }
 
+/// progress (optional) gets the fraction of registrations done, on the calling thread, every
+/// few registrations.
 template <typename S>
 std::vector<CrossLink> cross_links(
     const HierarchyResult<S>& ha, const std::vector<std::vector<ulc::Vec3<S>>>& frames_a,
     const std::vector<double>& times_a, const std::vector<Isometry3d>& poses_a,
     const HierarchyResult<S>& hb, const std::vector<std::vector<ulc::Vec3<S>>>& frames_b,
     const std::vector<double>& times_b, const std::vector<Isometry3d>& poses_b,
-    double time_offset_s, const CrossLinkOptions& options, CrossLinkStats* stats = nullptr) {
+    double time_offset_s, const CrossLinkOptions& options, CrossLinkStats* stats = nullptr,
+    const ulc::StepProgress& progress = {}) {
+  namespace d = cross_link_detail;
   std::vector<CrossLink> links;
   const std::size_t layers = std::min(ha.members.size(), hb.members.size());
+  const std::size_t first_layer = static_cast<std::size_t>(std::max(options.min_layer, 0));
+  std::vector<std::vector<std::size_t>> chosen(layers);
+  std::size_t total = 0, done_before = 0;
+  for (std::size_t l = first_layer; l < layers; ++l) {
+    if (ha.members[l].empty() || hb.members[l].empty()) continue;
+    chosen[l] = d::chosen_members(ha.members[l].size(), l, options);
+    total += chosen[l].size();
+  }
   const auto stages = ulc::coarse_to_fine_stages(options.gate);
-  for (std::size_t l = static_cast<std::size_t>(std::max(options.min_layer, 0)); l < layers; ++l) {
+  for (std::size_t l = first_layer; l < layers; ++l) {
     const auto& ma = ha.members[l];
     const auto& mb = hb.members[l];
-    if (ma.empty() || mb.empty()) continue;
+    if (chosen[l].empty()) continue;
     std::vector<double> tb;
     for (const auto& m : mb) tb.push_back(times_b[m.begin] + time_offset_s);
-    std::vector<std::size_t> chosen;
-    const std::size_t stride = l == 0 ? std::max<std::size_t>(options.layer0_stride, 1) : 1;
-    for (std::size_t i = 0; i < ma.size(); i += stride) chosen.push_back(i);
-    std::vector<CrossLink> slot(chosen.size());
-    std::vector<char> keep(chosen.size(), 0);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chosen.size(), 1),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                        for (std::size_t c = r.begin(); c != r.end(); ++c) {
-                          const auto& a = ma[chosen[c]];
-                          const auto& b = mb[cross_link_detail::nearest(tb, times_a[a.begin])];
-                          const auto& cloud_a = l == 0 ? frames_a[a.begin] : a.cloud;
-                          const auto& cloud_b = l == 0 ? frames_b[b.begin] : b.cloud;
-                          const Isometry3d initial = poses_a[a.begin].inverse() * poses_b[b.begin];
-                          const auto link =
-                              register_clouds(cloud_a, cloud_b, initial, options, stages);
-                          if (!link) continue;
-                          slot[c] = *link;
-                          slot[c].frame_a = a.begin;
-                          slot[c].frame_b = b.begin;
-                          slot[c].layer = static_cast<int>(l);
-                          keep[c] = 1;
-                        }
-                      });
-    for (std::size_t c = 0; c < chosen.size(); ++c) {
+    std::vector<std::optional<CrossLink>> slot(chosen[l].size());
+    ulc::parallel_for_in_batches(
+        chosen[l].size(), ulc::default_batch_size(),
+        [&](std::size_t c) {
+          const auto& a = ma[chosen[l][c]];
+          const auto& b = mb[d::nearest(tb, times_a[a.begin])];
+          const auto& cloud_a = l == 0 ? frames_a[a.begin] : a.cloud;
+          const auto& cloud_b = l == 0 ? frames_b[b.begin] : b.cloud;
+          const Isometry3d initial = poses_a[a.begin].inverse() * poses_b[b.begin];
+          slot[c] = register_clouds(cloud_a, cloud_b, initial, options, stages);
+          if (!slot[c]) return;
+          slot[c]->frame_a = a.begin;
+          slot[c]->frame_b = b.begin;
+          slot[c]->layer = static_cast<int>(l);
+        },
+        [&](std::size_t done) {
+          if (progress)
+            progress(static_cast<double>(done_before + done) / static_cast<double>(total));
+        });
+    done_before += chosen[l].size();
+    for (const auto& link : slot) {
       if (stats) ++stats->attempted;
-      if (!keep[c]) continue;
+      if (!link) continue;
       if (stats) ++stats->kept;
-      if (stats && slot[c].moved_rad < options.agree_rotation_rad &&
-          slot[c].moved_m < options.agree_translation_m)
+      if (stats && link->moved_rad < options.agree_rotation_rad &&
+          link->moved_m < options.agree_translation_m)
         ++stats->agreeing;
-      links.push_back(slot[c]);
+      links.push_back(*link);
     }
   }
   return links;

@@ -34,13 +34,11 @@
 #include <cstddef>
 #include <vector>
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include "hots/options.hpp"
 #include "hots/pose_graph.hpp"
 #include "hots/sweep_ba.hpp"
 #include "hots/window_ba.hpp"
+#include "ulc/core/batched_for.hpp"
 #include "ulc/core/point_cloud.hpp"
 #include "ulc/core/point_span.hpp"
 #include "ulc/core/voxel_downsample.hpp"
@@ -127,20 +125,186 @@ SweepWindow<ulc::PointSpan<S>> sweep_window(const std::vector<SweepParts<S>>& sw
   return sw;
 }
 
+/// What one window of a layer yields: its BA, the marginal information of its members'
+/// relative poses (empty: no usable BA, the members keep their poses), its submap for the next
+/// layer and, at a continuous layer 0, the factor to its end knot.
+template <typename S>
+struct WindowOutcome {
+  WindowBaResult ba;
+  bool ran = false;
+  std::vector<Mat6d> information;
+  HierarchyMember<S> submap;
+  std::vector<HierarchyFactor> end_factor;
+};
+
+/// A window's members: their clouds (frames at layer 0, submaps above) and current poses.
+template <typename S>
+struct WindowMembers {
+  std::vector<const std::vector<ulc::Vec3<S>>*> clouds;
+  std::vector<Isometry3d> poses;
+};
+
+/// The submap's entries (the members, or at a continuous layer 0 the parts of their sweeps),
+/// each entry's member and each entry's pose after the BA.
+template <typename S>
+struct WindowEntries {
+  std::vector<ulc::PointSpan<S>> spans;
+  std::vector<std::size_t> member;
+  std::vector<Isometry3d> poses;
+};
+
+/// The window's BA (rigid, or over its sweeps' parts at a continuous layer 0) into o, and the
+/// submap's entries with their poses.
+template <typename S>
+WindowEntries<S> window_ba_entries(const WindowMembers<S>& wm,
+                                   const std::vector<SweepParts<S>>* sweeps, std::size_t first,
+                                   std::size_t last, const Isometry3d* next_pose,
+                                   const HierarchyOptions& options, WindowOutcome<S>& o) {
+  WindowEntries<S> e;
+  for (const auto* c : wm.clouds) e.spans.emplace_back(*c);
+  for (std::size_t m = 0; m < wm.clouds.size(); ++m) e.member.push_back(m);
+  std::size_t knots = wm.clouds.size();
+  if (sweeps) {
+    const SweepWindow<ulc::PointSpan<S>> sw = sweep_window(*sweeps, first, last, options.end_knot);
+    std::vector<Isometry3d> knot_poses = wm.poses;
+    if (sw.deskew.size() > wm.clouds.size()) knot_poses.push_back(*next_pose);
+    knots = knot_poses.size();
+    SweepBaResult sr = sweep_window_ba(sw, knot_poses, options.ba);
+    o.ba = std::move(sr.ba);
+    e.spans.clear();
+    for (const ulc::PointSpan<S>* part : sw.clouds) e.spans.push_back(*part);
+    e.member = sw.sweep;
+    e.poses = std::move(sr.entry_poses);
+  } else {
+    o.ba = window_ba(wm.clouds, wm.poses, options.ba);
+    e.poses = o.ba.poses;
+  }
+  const bool usable = o.ba.ok() || o.ba.status == WindowBaStatus::not_converged;
+  if (usable) o.information = marginal_information(o.ba, options.min_sigma);
+  if (!usable || o.information.size() + 1 != knots) {
+    o.information.clear();
+    return e;
+  }
+  if (knots > wm.clouds.size() && options.end_knot_factor) {
+    HierarchyFactor f;  // to the next frame, where the last sweep ends
+    f.from = first;
+    f.to = last;
+    f.measured = o.ba.poses[0].inverse() * o.ba.poses.back();
+    f.information = o.information.back();
+    f.layer = 0;
+    o.end_factor.push_back(f);
+  }
+  o.information.resize(wm.clouds.size() - 1);
+  o.ba.poses.resize(wm.clouds.size());
+  return e;
+}
+
+/// Every entry's points in the first member's coordinates, voxel-downsampled.
+template <typename S>
+std::vector<ulc::Vec3<S>> merged_submap(const WindowEntries<S>& e, const Isometry3d& first_pose,
+                                        double voxel) {
+  const Isometry3d first_inv = first_pose.inverse();
+  std::vector<ulc::Vec3<S>> merged;
+  for (std::size_t k = 0; k < e.spans.size(); ++k) {
+    const Isometry3d T = first_inv * e.poses[k];
+    for (const auto& p : e.spans[k])
+      merged.push_back((T * p.template cast<double>()).template cast<S>());
+  }
+  const auto down = ulc::voxel_downsample(merged, voxel);
+  return down.ok() ? down.cloud.points : merged;
+}
+
+/// Window k of layer l: members [k w, k w + w) of `layer`, at the poses in `poses`.
+template <typename S>
+WindowOutcome<S> run_window(const std::vector<std::vector<ulc::Vec3<S>>>& frames,
+                            const std::vector<SweepParts<S>>* sweeps,
+                            const std::vector<HierarchyMember<S>>& layer, int l, std::size_t k,
+                            const std::vector<Isometry3d>& poses, const HierarchyOptions& options) {
+  const std::size_t w = options.window;
+  const std::size_t first = k * w, last = std::min(first + w, layer.size());
+  WindowMembers<S> wm;
+  for (std::size_t m = first; m < last; ++m) {
+    wm.clouds.push_back(l == 0 ? &frames[layer[m].begin] : &layer[m].cloud);
+    wm.poses.push_back(poses[layer[m].begin]);
+  }
+  WindowOutcome<S> o;
+  WindowEntries<S> e;
+  if (wm.clouds.size() >= 2) {
+    o.ran = true;
+    const bool continuous = l == 0 && sweeps;
+    const Isometry3d* next = last < poses.size() ? &poses[last] : nullptr;
+    e = window_ba_entries(wm, continuous ? sweeps : nullptr, first, last, next, options, o);
+  } else {
+    for (const auto* c : wm.clouds) e.spans.emplace_back(*c);
+    e.member.assign(1, 0);
+  }
+  if (o.information.empty()) {  // no usable BA: keep the start
+    o.ba.poses = wm.poses;
+    e.poses.clear();
+    for (std::size_t m : e.member) e.poses.push_back(wm.poses[m]);
+  }
+  o.submap.begin = layer[first].begin;
+  o.submap.end = layer[last - 1].end;
+  o.submap.cloud = merged_submap(e, o.ba.poses[0], options.submap_voxel);
+  return o;
+}
+
+/// Window k's outcome into out, in window order: its members' subtrees moved, its factors
+/// collected (see the header comment).
+template <typename S>
+void absorb_window(const std::vector<HierarchyMember<S>>& layer, int l, std::size_t k,
+                   std::size_t w, const WindowOutcome<S>& o, HierarchyResult<S>& out) {
+  const std::size_t first = k * w, last = std::min(first + w, layer.size());
+  if (o.ran) {
+    ++out.windows;
+    out.planes += o.ba.planes;
+    if (o.information.empty()) ++out.failed_windows;
+  }
+  for (std::size_t m = first; m < last; ++m) {
+    const Isometry3d delta = o.ba.poses[m - first] * out.poses[layer[m].begin].inverse();
+    for (std::size_t f = layer[m].begin; f < layer[m].end; ++f) out.poses[f] = delta * out.poses[f];
+    if (m > first && !o.information.empty()) {
+      HierarchyFactor factor;
+      factor.from = layer[first].begin;
+      factor.to = layer[m].begin;
+      factor.measured = o.ba.poses[0].inverse() * o.ba.poses[m - first];
+      factor.information = o.information[m - first - 1];
+      factor.layer = l;
+      out.factors.push_back(factor);
+    }
+  }
+  if (!o.information.empty())
+    out.factors.insert(out.factors.end(), o.end_factor.begin(), o.end_factor.end());
+}
+
+/// Windows over all layers for `frames` frames: what a progress fraction counts.
+inline std::size_t total_windows(std::size_t frames, const HierarchyOptions& options) {
+  std::size_t total = 0;
+  for (int l = 0; l < options.layers && frames >= 2; ++l) {
+    frames = (frames + options.window - 1) / options.window;
+    total += frames;
+  }
+  return total;
+}
+
 }  // namespace hierarchy_detail
 
-/// Builds and optimises the hierarchy of one LiDAR (see the header comment).
+/// Builds and optimises the hierarchy of one LiDAR (see the header comment). progress
+/// (optional) gets the fraction of windows done, on the calling thread, every few windows.
 template <typename S>
 HierarchyResult<S> build_hierarchy(const std::vector<std::vector<ulc::Vec3<S>>>& frames,
                                    const std::vector<Isometry3d>& poses,
                                    const HierarchyOptions& options = {},
-                                   const std::vector<SweepParts<S>>* sweeps = nullptr) {
-  using Cloud = std::vector<ulc::Vec3<S>>;
+                                   const std::vector<SweepParts<S>>* sweeps = nullptr,
+                                   const ulc::StepProgress& progress = {}) {
+  namespace d = hierarchy_detail;
   HierarchyResult<S> out;
   out.poses = poses;
   if (frames.size() != poses.size() || options.window < 2 || options.layers < 1) return out;
   if (sweeps && sweeps->size() != frames.size()) sweeps = nullptr;
-
+  const double total =
+      static_cast<double>(std::max<std::size_t>(d::total_windows(frames.size(), options), 1));
+  std::size_t done_before = 0;
   std::vector<HierarchyMember<S>> layer(frames.size());
   for (std::size_t f = 0; f < frames.size(); ++f) {
     layer[f].begin = f;
@@ -149,119 +313,20 @@ HierarchyResult<S> build_hierarchy(const std::vector<std::vector<ulc::Vec3<S>>>&
   for (int l = 0; l < options.layers && layer.size() >= 2; ++l) {
     const std::size_t w = options.window;
     const std::size_t n_windows = (layer.size() + w - 1) / w;
-    struct Outcome {
-      WindowBaResult ba;
-      bool ran = false;
-      std::vector<Mat6d> information;
-      HierarchyMember<S> submap;
-      std::vector<HierarchyFactor> end_factor;  ///< to the end knot (continuous layer 0)
-    };
-    std::vector<Outcome> outcomes(n_windows);
-    tbb::parallel_for(
-        tbb::blocked_range<std::size_t>(0, n_windows, 1),
-        [&](const tbb::blocked_range<std::size_t>& r) {
-          for (std::size_t k = r.begin(); k != r.end(); ++k) {
-            const std::size_t first = k * w, last = std::min(first + w, layer.size());
-            std::vector<const Cloud*> clouds;
-            std::vector<Isometry3d> member_poses;
-            for (std::size_t m = first; m < last; ++m) {
-              clouds.push_back(l == 0 ? &frames[layer[m].begin] : &layer[m].cloud);
-              member_poses.push_back(out.poses[layer[m].begin]);
-            }
-            Outcome& o = outcomes[k];
-            // The submap is made of entries: the members, or at a continuous layer 0 the
-            // parts of their sweeps (entry_member: each entry's member).
-            std::vector<ulc::PointSpan<S>> entries;
-            for (const Cloud* c : clouds) entries.emplace_back(*c);
-            std::vector<std::size_t> entry_member(clouds.size());
-            for (std::size_t m = 0; m < clouds.size(); ++m) entry_member[m] = m;
-            std::vector<Isometry3d> entry_poses;
-            if (clouds.size() >= 2) {
-              o.ran = true;
-              std::size_t knots = clouds.size();
-              if (l == 0 && sweeps) {
-                const SweepWindow<ulc::PointSpan<S>> sw =
-                    hierarchy_detail::sweep_window(*sweeps, first, last, options.end_knot);
-                std::vector<Isometry3d> knot_poses = member_poses;
-                if (sw.deskew.size() > clouds.size()) knot_poses.push_back(out.poses[last]);
-                knots = knot_poses.size();
-                SweepBaResult sr = sweep_window_ba(sw, knot_poses, options.ba);
-                o.ba = std::move(sr.ba);
-                entries.clear();
-                for (const ulc::PointSpan<S>* part : sw.clouds) entries.push_back(*part);
-                entry_member = sw.sweep;
-                entry_poses = std::move(sr.entry_poses);
-              } else {
-                o.ba = window_ba(clouds, member_poses, options.ba);
-                entry_poses = o.ba.poses;
-              }
-              const bool usable = o.ba.ok() || o.ba.status == WindowBaStatus::not_converged;
-              if (usable)
-                o.information = hierarchy_detail::marginal_information(o.ba, options.min_sigma);
-              if (usable && o.information.size() + 1 == knots) {
-                if (knots > clouds.size() && options.end_knot_factor) {
-                  HierarchyFactor f;  // to the next frame, where the last sweep ends
-                  f.from = layer[first].begin;
-                  f.to = last;
-                  f.measured = o.ba.poses[0].inverse() * o.ba.poses.back();
-                  f.information = o.information.back();
-                  f.layer = 0;
-                  o.end_factor.push_back(f);
-                }
-                o.information.resize(clouds.size() - 1);
-                o.ba.poses.resize(clouds.size());
-              } else {
-                o.information.clear();
-              }
-            }
-            if (o.information.empty()) {  // no usable BA: keep the start
-              o.ba.poses = member_poses;
-              entry_poses.clear();
-              for (std::size_t e = 0; e < entries.size(); ++e)
-                entry_poses.push_back(member_poses[entry_member[e]]);
-            }
-            // The submap: every entry's points in the first member's coordinates.
-            const Isometry3d first_inv = o.ba.poses[0].inverse();
-            Cloud merged;
-            for (std::size_t e = 0; e < entries.size(); ++e) {
-              const Isometry3d T = first_inv * entry_poses[e];
-              for (const auto& p : entries[e])
-                merged.push_back((T * p.template cast<double>()).template cast<S>());
-            }
-            o.submap.begin = layer[first].begin;
-            o.submap.end = layer[last - 1].end;
-            const auto down = ulc::voxel_downsample(merged, options.submap_voxel);
-            o.submap.cloud = down.ok() ? down.cloud.points : merged;
-          }
+    std::vector<d::WindowOutcome<S>> outcomes(n_windows);
+    ulc::parallel_for_in_batches(
+        n_windows, ulc::default_batch_size(),
+        [&](std::size_t k) {
+          outcomes[k] = d::run_window(frames, sweeps, layer, l, k, out.poses, options);
+        },
+        [&](std::size_t done) {
+          if (progress) progress(static_cast<double>(done_before + done) / total);
         });
-    // Serial, in window order: move subtrees, collect factors, form the next layer.
+    done_before += n_windows;
     std::vector<HierarchyMember<S>> next;
     for (std::size_t k = 0; k < n_windows; ++k) {
-      Outcome& o = outcomes[k];
-      const std::size_t first = k * w, last = std::min(first + w, layer.size());
-      if (o.ran) {
-        ++out.windows;
-        out.planes += o.ba.planes;
-        if (o.information.empty()) ++out.failed_windows;
-      }
-      for (std::size_t m = first; m < last; ++m) {
-        const Isometry3d old_pose = out.poses[layer[m].begin];
-        const Isometry3d delta = o.ba.poses[m - first] * old_pose.inverse();
-        for (std::size_t f = layer[m].begin; f < layer[m].end; ++f)
-          out.poses[f] = delta * out.poses[f];
-        if (m > first && !o.information.empty()) {
-          HierarchyFactor factor;
-          factor.from = layer[first].begin;
-          factor.to = layer[m].begin;
-          factor.measured = o.ba.poses[0].inverse() * o.ba.poses[m - first];
-          factor.information = o.information[m - first - 1];
-          factor.layer = l;
-          out.factors.push_back(factor);
-        }
-      }
-      if (!o.information.empty())
-        out.factors.insert(out.factors.end(), o.end_factor.begin(), o.end_factor.end());
-      next.push_back(std::move(o.submap));
+      d::absorb_window(layer, l, k, w, outcomes[k], out);
+      next.push_back(std::move(outcomes[k].submap));
     }
     out.members.push_back(std::move(layer));
     layer = std::move(next);

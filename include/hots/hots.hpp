@@ -83,7 +83,9 @@ using RefineProgress = std::function<void(double share)>;
 
 /// See the header comment. a and b are LidarSequences with their odometry poses; S is the
 /// scalar of the prepared point clouds (float is plenty). progress (optional) is called on the
-/// calling thread after each phase.
+/// calling thread after each phase and within them: every few windows of the hierarchies and
+/// registrations of the cross links (ulc/core/batched_for.hpp), after each sub-step of the
+/// whole-sequence step; it may throw to stop refine there.
 template <typename S = float, class SeqA, class SeqB>
 RefineResult refine(const SeqA& a, const SeqB& b, const Isometry3d& extrinsic,
                     const RefineOptions& options = {}, const RefineProgress& progress = {}) {
@@ -107,11 +109,15 @@ RefineResult refine(const SeqA& a, const SeqB& b, const Isometry3d& extrinsic,
   auto done = [&progress](double share) {
     if (progress) progress(share);
   };
-  d::prepare_lidars(a, b, s, options, st);
+  // A phase's own fraction f, as the share of refine done: from + (to - from) f.
+  auto within = [&done](double from, double to) {
+    return [&done, from, to](double f) { done(from + (to - from) * f); };
+  };
+  d::prepare_lidars(a, b, s, options, st, within(0.0, 0.06));
   done(0.06);
-  d::build_hierarchies(s, options, st);
+  d::build_hierarchies(s, options, st, within(0.06, 0.41));
   done(0.41);
-  const bool linked = d::link_lidars(s, options.time_offset_s, options, st);
+  const bool linked = d::link_lidars(s, options.time_offset_s, options, st, within(0.41, 0.68));
   done(0.68);
   if (!linked)
     return fail(RefineStatus::extrinsic_unconfirmed,
@@ -122,7 +128,7 @@ RefineResult refine(const SeqA& a, const SeqB& b, const Isometry3d& extrinsic,
   if (const RefineStatus status = d::solve_passes(s, options, result); status != RefineStatus::ok)
     return fail(status, result.reason);
   done(0.69);
-  if (options.sequence.enabled && !d::sequence_step(s, options, result))
+  if (options.sequence.enabled && !d::sequence_step(s, options, result, within(0.69, 1.0)))
     return fail(RefineStatus::sequence_failed, result.reason);
   d::output_poses(s, result);
   if (!st.sequence.time_offset_trusted)

@@ -10,10 +10,6 @@
 #include <optional>
 #include <vector>
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#include <Eigen/Cholesky>
-
 #include "hots/boundary_bridges.hpp"
 #include "hots/boundary_links.hpp"
 #include "hots/cross_links.hpp"
@@ -24,9 +20,10 @@
 #include "hots/sequence_extrinsic.hpp"
 #include "hots/sparse_lm.hpp"
 #include "hots/time_sync.hpp"
+#include "ulc/core/batched_for.hpp"
 #include "ulc/core/deskew.hpp"
+#include "ulc/core/mahalanobis.hpp"
 #include "ulc/core/point_traits.hpp"
-#include "ulc/core/small_sample.hpp"
 #include "ulc/core/voxel_downsample.hpp"
 
 namespace hots {
@@ -87,36 +84,39 @@ SweepParts<S> order_by_part(std::vector<ulc::Vec3<S>>& points, const std::vector
 /// frame's kept points are also ordered by part of the sweep and `sweeps` holds the parts
 /// (order_by_part; a frame without point times is one part at fraction 0): views into the
 /// returned frames, valid while those vectors are neither copied from nor reallocated.
+/// progress (optional) gets the fraction of frames done, every few frames.
 template <typename S, class Frames, class Sweep>
 std::vector<std::vector<ulc::Vec3<S>>> prepare_frames(const Frames& frames, const Sweep& sweep,
                                                       double voxel, std::size_t stride = 1,
                                                       std::vector<SweepParts<S>>* sweeps = nullptr,
-                                                      int parts = 1) {
+                                                      int parts = 1,
+                                                      const ulc::StepProgress& progress = {}) {
   std::vector<std::vector<ulc::Vec3<S>>> out(frames.size());
   if (sweeps) sweeps->assign(frames.size(), SweepParts<S>{});
   stride = std::max<std::size_t>(stride, 1);
-  tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, frames.size(), 1),
-      [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t k = r.begin(); k != r.end(); ++k) {
-          if (k % stride != 0) continue;
-          const std::pair<Isometry3d, double> motion = sweep(k);
-          const auto& frame = frames[k];  // once: a FrameSource reads it on each access
-          auto deskewed = ulc::deskew(frame, motion.first, motion.second);
-          const bool timed = sweeps && ulc::traits::has_time(frame) && motion.second > 0.0;
-          if (timed) {
-            deskewed.times.resize(deskewed.points.size());
-            for (std::size_t i = 0; i < deskewed.points.size(); ++i)
-              deskewed.times[i] = ulc::traits::time(frame, i);
-          }
-          const auto down = ulc::voxel_downsample(deskewed, voxel);
-          const auto& cloud = down.ok() ? down.cloud : deskewed;
-          out[k].reserve(cloud.points.size());
-          for (const auto& p : cloud.points) out[k].push_back(p.template cast<S>());
-          if (!sweeps) continue;
-          const bool split = timed && cloud.times.size() == out[k].size();
-          (*sweeps)[k] = order_by_part(out[k], split ? &cloud.times : nullptr, motion, parts);
+  ulc::parallel_for_in_batches(
+      frames.size(), ulc::default_batch_size(),
+      [&](std::size_t k) {
+        if (k % stride != 0) return;
+        const std::pair<Isometry3d, double> motion = sweep(k);
+        const auto& frame = frames[k];  // once: a FrameSource reads it on each access
+        auto deskewed = ulc::deskew(frame, motion.first, motion.second);
+        const bool timed = sweeps && ulc::traits::has_time(frame) && motion.second > 0.0;
+        if (timed) {
+          deskewed.times.resize(deskewed.points.size());
+          for (std::size_t i = 0; i < deskewed.points.size(); ++i)
+            deskewed.times[i] = ulc::traits::time(frame, i);
         }
+        const auto down = ulc::voxel_downsample(deskewed, voxel);
+        const auto& cloud = down.ok() ? down.cloud : deskewed;
+        out[k].reserve(cloud.points.size());
+        for (const auto& p : cloud.points) out[k].push_back(p.template cast<S>());
+        if (!sweeps) return;
+        const bool split = timed && cloud.times.size() == out[k].size();
+        (*sweeps)[k] = order_by_part(out[k], split ? &cloud.times : nullptr, motion, parts);
+      },
+      [&](std::size_t done) {
+        if (progress) progress(static_cast<double>(done) / static_cast<double>(frames.size()));
       });
   return out;
 }
@@ -133,9 +133,11 @@ inline std::pair<Isometry3d, double> own_sweep(const std::vector<double>& times,
 template <typename S, class Frames>
 std::vector<std::vector<ulc::Vec3<S>>> prepare_frames(
     const Frames& frames, const std::vector<double>& times, const std::vector<Isometry3d>& poses,
-    double voxel, std::vector<SweepParts<S>>* sweeps = nullptr, int parts = 1) {
+    double voxel, std::vector<SweepParts<S>>* sweeps = nullptr, int parts = 1,
+    const ulc::StepProgress& progress = {}) {
   return prepare_frames<S>(
-      frames, [&](std::size_t k) { return own_sweep(times, poses, k); }, voxel, 1, sweeps, parts);
+      frames, [&](std::size_t k) { return own_sweep(times, poses, k); }, voxel, 1, sweeps, parts,
+      progress);
 }
 
 /// The a frame nearest to t (a's clock) and a's motion from it to t (interpolated or
@@ -225,28 +227,44 @@ Isometry3d map_b_in_map_a(const RefineLidar<S>& a, const RefineLidar<S>& b,
   return a.odometry.front() * extrinsic * b_at_t0.inverse();
 }
 
-/// Both LiDARs' frames deskewed with their own odometry and thinned (statistics: prepare).
+/// a's share of work that grows with the frames: its frames over both LiDARs'.
+inline double share_of_a(std::size_t frames_a, std::size_t frames_b) {
+  const double a = static_cast<double>(frames_a);
+  return a / std::max(a + static_cast<double>(frames_b), 1.0);
+}
+
+/// Both LiDARs' frames deskewed with their own odometry and thinned (statistics: prepare);
+/// progress gets the fraction done, a's frames first.
 template <typename S, class SeqA, class SeqB>
 void prepare_lidars(const SeqA& seq_a, const SeqB& seq_b, RefineState<S>& s,
-                    const RefineOptions& options, RefineStatistics& st) {
+                    const RefineOptions& options, RefineStatistics& st,
+                    const ulc::StepProgress& progress) {
   const int parts = options.hierarchy.sweep_parts;
+  const double share_a = share_of_a(s.a.times.size(), s.b.times.size());
   s.a.world = s.a.odometry;
   for (const auto& T : s.b.odometry) s.b.world.push_back(s.mapa_mapb * T);
   s.a.frames = prepare_frames<S>(seq_a.frames, s.a.times, s.a.odometry, options.frame_voxel,
-                                 parts > 1 ? &s.a.sweeps : nullptr, parts);
+                                 parts > 1 ? &s.a.sweeps : nullptr, parts,
+                                 [&](double f) { progress(share_a * f); });
   s.b.frames = prepare_frames<S>(seq_b.frames, s.b.times, s.b.odometry, options.frame_voxel,
-                                 parts > 1 ? &s.b.sweeps : nullptr, parts);
+                                 parts > 1 ? &s.b.sweeps : nullptr, parts,
+                                 [&](double f) { progress(share_a + (1.0 - share_a) * f); });
   st.prepare_seconds = lap(s.clock);
 }
 
 /// Each LiDAR's hierarchy of windows (hierarchy.hpp) and bridges across its top-layer
 /// boundaries (boundary_bridges.hpp); the world poses become the hierarchy's.
+/// progress gets the fraction done, a's frames first (the work grows with the frames).
 template <typename S>
-void build_hierarchies(RefineState<S>& s, const RefineOptions& options, RefineStatistics& st) {
+void build_hierarchies(RefineState<S>& s, const RefineOptions& options, RefineStatistics& st,
+                       const ulc::StepProgress& progress) {
+  const double share_a = share_of_a(s.a.frames.size(), s.b.frames.size());
   for (RefineLidar<S>* l : {&s.a, &s.b}) {
     const bool parts = options.hierarchy.sweep_parts > 1;
+    const double from = l == &s.a ? 0.0 : share_a, width = l == &s.a ? share_a : 1.0 - share_a;
     l->hierarchy =
-        build_hierarchy(l->frames, l->world, options.hierarchy, parts ? &l->sweeps : nullptr);
+        build_hierarchy(l->frames, l->world, options.hierarchy, parts ? &l->sweeps : nullptr,
+                        [&](double f) { progress(from + width * f); });
   }
   for (RefineLidar<S>* l : {&s.a, &s.b})
     if (options.boundary_bridges)
@@ -263,12 +281,13 @@ void build_hierarchies(RefineState<S>& s, const RefineOptions& options, RefineSt
 /// The cross links between the LiDARs (cross_links.hpp); false when too few agree with the
 /// extrinsic (see links_confirm). Then each LiDAR's top-layer boundaries registered
 /// (boundary_links.hpp) (statistics: cross_links).
+/// progress gets the fraction of cross links registered.
 template <typename S>
 bool link_lidars(RefineState<S>& s, double time_offset_s, const RefineOptions& options,
-                 RefineStatistics& st) {
+                 RefineStatistics& st, const ulc::StepProgress& progress) {
   CrossLinkStats link_stats;
   s.links = cross_links(s.a.hierarchy, s.a.frames, s.a.times, s.a.world, s.b.hierarchy, s.b.frames,
-                        s.b.times, s.b.world, time_offset_s, options.links, &link_stats);
+                        s.b.times, s.b.world, time_offset_s, options.links, &link_stats, progress);
   st.cross_links = s.links.size();
   st.cross_links_attempted = link_stats.attempted;
   st.cross_links_agreeing = link_stats.agreeing;
@@ -465,23 +484,22 @@ RefineStatus solve_passes(RefineState<S>& s, const RefineOptions& options, Refin
 /// from JEEP's, 0.3 cm off, it ended 6.3 cm off; the two costs 0.4 % apart).
 template <typename S>
 Vec6d rerun_from_start(const RefineState<S>& s, const SequenceExtrinsicOptions& so, double start_dt,
-                       const Mat6d& covariance, RefineResult& result) {
+                       const Mat6d& covariance, RefineResult& result,
+                       const ulc::StepProgress& progress) {
   const Vec6d away = ulc::se3_log(Isometry3d(s.start * result.extrinsic.inverse()));
-  const Eigen::LDLT<Mat6d> ldlt(covariance);
-  const bool invertible = ldlt.info() == Eigen::Success && ldlt.vectorD().minCoeff() > 0.0;
-  if (invertible &&
-      away.dot(ldlt.solve(away)) <= ulc::chi_square_quantile(ulc::kThreeSigmaLevel, 6))
-    return Vec6d::Zero();
+  if (ulc::within_three_sigma(away, covariance)) return Vec6d::Zero();
   SequenceExtrinsicResult& rerun = result.statistics.sequence_rerun;
   rerun = sequence_extrinsic(s.a.hierarchy, s.a.frames, s.a.times, graph_poses(s, s.a), s.b.frames,
-                             s.b.times, s.start, start_dt, so);
+                             s.b.times, s.start, start_dt, so, progress);
   if (!rerun.ok()) return Vec6d::Zero();
   return ulc::se3_log(Isometry3d(rerun.extrinsic * result.extrinsic.inverse()));
 }
 
-/// False when it failed (result.reason says why).
+/// False when it failed (result.reason says why). progress gets the fraction done: the step to
+/// 0.8, its rerun (when it runs) the rest.
 template <typename S>
-bool sequence_step(RefineState<S>& s, const RefineOptions& options, RefineResult& result) {
+bool sequence_step(RefineState<S>& s, const RefineOptions& options, RefineResult& result,
+                   const ulc::StepProgress& progress) {
   RefineStatistics& st = result.statistics;
   // The joint dt is refined only where the synchronisation found an offset at all: its
   // significance test is what keeps a synchronised rig at exactly zero.
@@ -491,9 +509,9 @@ bool sequence_step(RefineState<S>& s, const RefineOptions& options, RefineResult
   so.check_time_offset = so.check_time_offset && options.synchronise_time;
   const auto t0 = std::chrono::steady_clock::now();
   const double start_dt = result.time_offset_s;
-  st.sequence =
-      sequence_extrinsic(s.a.hierarchy, s.a.frames, s.a.times, graph_poses(s, s.a), s.b.frames,
-                         s.b.times, result.extrinsic, result.time_offset_s, so);
+  st.sequence = sequence_extrinsic(s.a.hierarchy, s.a.frames, s.a.times, graph_poses(s, s.a),
+                                   s.b.frames, s.b.times, result.extrinsic, result.time_offset_s,
+                                   so, [&](double f) { progress(0.8 * f); });
   if (!st.sequence.ok()) {
     result.reason = st.sequence.reason;
     return false;
@@ -509,7 +527,8 @@ bool sequence_step(RefineState<S>& s, const RefineOptions& options, RefineResult
     // a rank-one term (hots.hpp).
     const Vec6d moved = ulc::se3_log(Isometry3d(graph_answer * result.extrinsic.inverse()));
     result.covariance_6x6 = st.sequence.covariance_6x6 + moved * moved.transpose();
-    const Vec6d rerun = rerun_from_start(s, so, start_dt, result.covariance_6x6, result);
+    const Vec6d rerun = rerun_from_start(s, so, start_dt, result.covariance_6x6, result,
+                                         [&](double f) { progress(0.8 + 0.2 * f); });
     result.covariance_6x6 += rerun * rerun.transpose();
   }
   st.sequence_seconds =

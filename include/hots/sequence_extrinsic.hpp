@@ -82,6 +82,7 @@
 #include "hots/options.hpp"
 #include "hots/refine_statistics.hpp"
 #include "hots/time_sync.hpp"
+#include "ulc/core/batched_for.hpp"
 #include "ulc/core/cluster_covariance.hpp"
 #include "ulc/core/gauss_newton.hpp"
 #include "ulc/core/point_to_plane.hpp"
@@ -621,7 +622,9 @@ void take_solve(const Solve& s, const SequenceProblem<S>& problem,
 }  // namespace sequence_detail
 
 /// See the header comment. world_a: T_world_a after the pose graph; frames_b: b's prepared
-/// (deskewed, downsampled) frames in b's body frame at times_b.
+/// (deskewed, downsampled) frames in b's body frame at times_b. progress (optional) is called
+/// on the calling thread after each of its six sub-steps (submaps, problem, solve, offset
+/// check, solve without the offset, covariance), as equal fractions.
 template <typename S>
 SequenceExtrinsicResult sequence_extrinsic(const HierarchyResult<S>& ha,
                                            const std::vector<std::vector<ulc::Vec3<S>>>& frames_a,
@@ -629,8 +632,12 @@ SequenceExtrinsicResult sequence_extrinsic(const HierarchyResult<S>& ha,
                                            const std::vector<Isometry3d>& world_a,
                                            const std::vector<std::vector<ulc::Vec3<S>>>& frames_b,
                                            const std::vector<double>& times_b, const Isometry3d& C0,
-                                           double dt0, const SequenceExtrinsicOptions& o = {}) {
+                                           double dt0, const SequenceExtrinsicOptions& o = {},
+                                           const ulc::StepProgress& progress = {}) {
   namespace d = sequence_detail;
+  auto done = [&progress](int sub_steps) {
+    if (progress) progress(sub_steps / 6.0);
+  };
   SequenceExtrinsicResult result;
   result.extrinsic = C0;
   result.time_offset_s = result.joint_time_offset_s = dt0;
@@ -647,22 +654,27 @@ SequenceExtrinsicResult sequence_extrinsic(const HierarchyResult<S>& ha,
   const d::BaseSubmaps<S> submaps = d::base_submaps(ha, frames_a, times_a, o);
   if (submaps.planes.empty()) return fail(SequenceExtrinsicStatus::invalid_input, "no submaps");
   result.targets = submaps.planes.size();
+  done(1);
   auto problem = d::sequence_problem(submaps, times_a, world_a, frames_b, times_b, dt0, o);
-
+  done(2);
   const bool joint = o.estimate_time_offset || o.check_time_offset;
   d::Solve s = d::solve(problem, C0, dt0, joint, o, result.iterations);
   if (!s.ok) return fail(SequenceExtrinsicStatus::registration_failed, s.reason);
   if (joint) d::judge_joint_offset(s, dt0, o, result);
+  done(3);
   if (o.check_time_offset) d::check_offset(problem, s, dt0, o, result);
+  done(4);
   if (joint && !result.time_offset_refined) {
     s = d::solve(problem, C0, dt0, false, o, result.iterations);
     if (!s.ok) return fail(SequenceExtrinsicStatus::registration_failed, s.reason);
   }
+  done(5);
   d::take_solve(s, problem, result);
   if (const auto c = d::extrinsic_covariance(problem, s, joint && result.time_offset_refined, o)) {
     result.covariance_6x6 = *c;
     result.has_covariance = true;
   }
+  done(6);
   return result;
 }
 

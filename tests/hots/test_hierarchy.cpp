@@ -154,3 +154,38 @@ TEST_CASE("bridges tie the top layer's submaps across their boundaries", "[hots]
   CHECK(none.factors.empty());
   CHECK(none.windows == 0);
 }
+
+TEST_CASE("the hierarchy reports its windows as they finish, and stops when the hook throws",
+          "[hots][hierarchy][progress]") {
+  const Scene& s = scene();
+  HierarchyOptions options;
+  options.window = 2;
+  options.layers = 4;  // 12 frames: 6 + 3 + 2 + 1 windows
+  std::vector<double> seen;
+  HierarchyResult<float> with, without;
+  tbb::task_arena(1).execute([&] {
+    with = build_hierarchy<float>(s.frames, s.start, options, nullptr,
+                                  [&](double f) { seen.push_back(f); });
+    without = build_hierarchy(s.frames, s.start, options);
+  });
+  // One thread: batches of 4 windows, so layer 0 reports twice (4 and 6 of 12 windows).
+  REQUIRE(seen.size() == 5);
+  CHECK(seen.front() == Approx(4.0 / 12.0));
+  for (std::size_t k = 1; k < seen.size(); ++k) CHECK(seen[k] > seen[k - 1]);
+  CHECK(seen.back() == Approx(1.0));
+  // Reporting changes nothing in the result.
+  REQUIRE(with.poses.size() == without.poses.size());
+  for (std::size_t k = 0; k < with.poses.size(); ++k)
+    CHECK(with.poses[k].matrix() == without.poses[k].matrix());
+  CHECK(with.factors.size() == without.factors.size());
+  // A hook that throws (Ctrl-C from Python) ends the build at the next report.
+  struct Stop {};
+  int calls = 0;
+  CHECK_THROWS_AS(build_hierarchy<float>(s.frames, s.start, options, nullptr,
+                                         [&](double) {
+                                           ++calls;
+                                           throw Stop{};
+                                         }),
+                  Stop);
+  CHECK(calls == 1);
+}
