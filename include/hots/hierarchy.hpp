@@ -10,7 +10,9 @@
 //     that frame's pose, its cloud is the subtree's points in that frame's coordinates. So a
 //     submap needs no variable of its own in the pose graph; its factors tie anchor frames.
 //   - Windows are consecutive runs of w members (the last run may be shorter; a run of one is
-//     carried up unchanged). Windows of a layer run as TBB tasks, each into its own slot.
+//     carried up unchanged). Windows of a layer run as TBB tasks, each into its own slot, in
+//     batches of a few per thread with the caller's progress between them
+//     (ulc/core/batched_for.hpp); their outcomes are absorbed serially, in window order.
 //   - After a window's BA, every frame of member k's subtree moves with it:
 //     T <- T_k,new T_k,old^-1 T. `poses` holds the result of all layers.
 //   - Each window with a usable BA yields one relative-pose factor per member k >= 1: from the
