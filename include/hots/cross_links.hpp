@@ -27,7 +27,8 @@
 //     deg); from the wrong one JEEP accepted (11.3 deg / 5.2 m off) all 27 kept links moved
 //     1.6-14.8 deg, none agreed. hots.hpp's trust rule counts agreeing links.
 //   - Registrations run as TBB tasks, one slot each, in batches with the caller's progress
-//     between them (ulc/core/batched_for.hpp); the kept links are in (layer, a member) order. Nothing here throws or prints.
+//     between them (ulc/core/batched_for.hpp); the kept links are in (layer, a member) order.
+//     Nothing here throws or prints.
 #pragma once
 
 #include <algorithm>
