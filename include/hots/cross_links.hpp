@@ -28,7 +28,7 @@
 //     1.6-14.8 deg, none agreed. hots.hpp's trust rule counts agreeing links.
 //   - Registrations run as TBB tasks, one slot each, in batches with the caller's progress
 //     between them (ulc/core/batched_for.hpp); the kept links are in (layer, a member) order.
-//     Nothing here throws or prints.
+//     Nothing here throws (a throwing progress hook passes through) or prints.
 #pragma once
 
 #include <algorithm>

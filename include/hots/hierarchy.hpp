@@ -28,7 +28,8 @@
 //     end_knot and a next frame, that frame's pose (where the last sweep ends); the submap
 //     places each part at its own pose. The next frame's estimate is dropped, or kept as one
 //     more factor from the window's anchor (end_knot_factor).
-//   - Nothing here throws or prints; the same results for any number of threads.
+//   - Nothing here throws (a throwing progress hook passes through) or prints; the same results
+//     for any number of threads.
 #pragma once
 
 #include <algorithm>

@@ -64,7 +64,8 @@
 //     had 0-1 agreeing links of 90 (64-tele, horizon-tele) and 0 of 538 (the rig's Tele, whose 27
 //     kept links all moved 1.6-14.8 deg); right ones on the Tele pairs at least 8 of 90 and 35 of
 //     538.
-//   - Nothing here throws or prints; results are the same for any number of threads.
+//   - Nothing here throws (a throwing progress hook passes through) or prints; results are the
+//     same for any number of threads.
 #pragma once
 
 #include <functional>

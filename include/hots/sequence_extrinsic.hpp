@@ -57,8 +57,8 @@
 //     few frames by Hotelling's T^2 (ulc/core/small_sample.hpp). Measured in
 //     docs/experiments/covariance_coverage.md.
 //   - The result keeps C and dt of the input when the registration fails (status says why).
-//   - Nothing here throws or prints; the same results for any number of threads (per-term
-//     deterministic reductions summed in term order).
+//   - Nothing here throws (a throwing progress hook passes through) or prints; the same results
+//     for any number of threads (per-term deterministic reductions summed in term order).
 #pragma once
 
 #include <algorithm>
