@@ -45,20 +45,28 @@ DisturbedStart disturbed_start() {
   return s;
 }
 
+/// hots::refine on the test drive with poses pa and pb, from `start`.
+hots::RefineResult refine_drive(const std::vector<ulc::Isometry3d>& pa,
+                                const std::vector<ulc::Isometry3d>& pb,
+                                const ulc::Isometry3d& start, const hots::RefineOptions& options,
+                                const hots::RefineProgress& progress = {}) {
+  const auto& a = drive().data.lidars[0];
+  const auto& b = drive().data.lidars[1];
+  return hots::refine(ulc::make_sequence(a.frames, a.timestamps, pa),
+                      ulc::make_sequence(b.frames, b.timestamps, pb), start, options, progress);
+}
+
 }  // namespace
 
 TEST_CASE("refine improves a disturbed extrinsic on a simulated 64-32 drive", "[hots][refine]") {
   const Drive& d = drive();
   const auto& a = d.data.lidars[0];
-  const auto& b = d.data.lidars[1];
   REQUIRE(a.frames.size() >= 25);
   const auto [C_gt, C0, pa, pb] = disturbed_start();
   hots::RefineOptions options;
   std::vector<double> shares;
   const hots::RefineResult r =
-      hots::refine(ulc::make_sequence(a.frames, a.timestamps, pa),
-                   ulc::make_sequence(b.frames, b.timestamps, pb), C0, options,
-                   [&](double share) { shares.push_back(share); });
+      refine_drive(pa, pb, C0, options, [&](double share) { shares.push_back(share); });
   INFO(hots::to_string(r.status) << ": " << r.reason);
   // Progress: after each phase and within the hierarchies and cross links, never backwards.
   CHECK(shares.size() > 4);
@@ -101,15 +109,11 @@ TEST_CASE("the whole-sequence step runs again from a start its answer's ellipsoi
   // ~3 cm off, far beyond the step's millimetre ellipsoid, the step runs again from that start
   // and the two answers' difference joins the covariance as a rank-one term beside the move
   // from the graph's C. Started at that answer instead, the start lies inside: no rerun.
-  const Drive& d = drive();
-  const auto& a = d.data.lidars[0];
-  const auto& b = d.data.lidars[1];
   const auto [C_gt, C0, pa, pb] = disturbed_start();
   hots::RefineOptions options;
   options.synchronise_time = false;
   const auto refine_from = [&](const ulc::Isometry3d& start) {
-    return hots::refine(ulc::make_sequence(a.frames, a.timestamps, pa),
-                        ulc::make_sequence(b.frames, b.timestamps, pb), start, options);
+    return refine_drive(pa, pb, start, options);
   };
   const auto log_ratio = [](const ulc::Isometry3d& x, const ulc::Isometry3d& y) {
     return ulc::se3_log(ulc::Isometry3d(x * y.inverse()));
@@ -153,8 +157,7 @@ TEST_CASE("refine with rigid frames or continuous-time sweeps in the layer-0 BA"
   hots::RefineResult r;
   for (const int parts : {1, 2}) {
     options.hierarchy.sweep_parts = parts;
-    r = hots::refine(ulc::make_sequence(a.frames, a.timestamps, pa),
-                     ulc::make_sequence(b.frames, b.timestamps, pb), C0, options);
+    r = refine_drive(pa, pb, C0, options);
     INFO("parts " << parts << ": " << hots::to_string(r.status) << ": " << r.reason);
     REQUIRE(r.ok());
     const auto e0 = ulc::pose_error(C_gt, C0);
@@ -171,9 +174,7 @@ TEST_CASE("refine with rigid frames or continuous-time sweeps in the layer-0 BA"
   }
   // With end_knot_factor, every layer-0 window but each LiDAR's last adds its end knot's factor.
   options.hierarchy.end_knot_factor = true;
-  const hots::RefineResult rf =
-      hots::refine(ulc::make_sequence(a.frames, a.timestamps, pa),
-                   ulc::make_sequence(b.frames, b.timestamps, pb), C0, options);
+  const hots::RefineResult rf = refine_drive(pa, pb, C0, options);
   REQUIRE(rf.ok());
   const std::size_t windows_a = (a.frames.size() + 4) / 5, windows_b = (b.frames.size() + 4) / 5;
   CHECK(rf.statistics.ba_factors == r.statistics.ba_factors + windows_a - 1 + windows_b - 1);
@@ -226,9 +227,7 @@ TEST_CASE("an extrinsic the LiDARs' views do not confirm is refused", "[hots][re
   const auto pa = drifting(d.truth_a, a.timestamps, 1);
   const auto pb = drifting(d.truth_b, b.timestamps, 2);
   hots::RefineOptions options;
-  const hots::RefineResult r =
-      hots::refine(ulc::make_sequence(a.frames, a.timestamps, pa),
-                   ulc::make_sequence(b.frames, b.timestamps, pb), wrong, options);
+  const hots::RefineResult r = refine_drive(pa, pb, wrong, options);
   const auto& st = r.statistics;
   INFO(hots::to_string(r.status) << ": " << r.reason << "; links " << st.cross_links << "/"
                                  << st.cross_links_attempted);
@@ -241,9 +240,7 @@ TEST_CASE("an extrinsic the LiDARs' views do not confirm is refused", "[hots][re
   CHECK(st.graph_iterations == 0);
   // The rule is the statistics' own verdict: off, the same run reaches the next check.
   options.min_cross_link_ratio = 0.0;
-  const hots::RefineResult unchecked =
-      hots::refine(ulc::make_sequence(a.frames, a.timestamps, pa),
-                   ulc::make_sequence(b.frames, b.timestamps, pb), wrong, options);
+  const hots::RefineResult unchecked = refine_drive(pa, pb, wrong, options);
   CHECK(unchecked.status != hots::RefineStatus::extrinsic_unconfirmed);
   // ... and the graph, with no link to hold the extrinsic, misses the rig bar (0.1 deg, 2 cm)
   // by far. (The whole-sequence step after it may still find the truth from there: on this
