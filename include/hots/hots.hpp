@@ -68,11 +68,11 @@
 //     same for any number of threads.
 #pragma once
 
-#include <functional>
 #include <utility>
 
 #include "hots/refine_statistics.hpp"
 #include "hots/refine_steps.hpp"
+#include "ulc/core/batched_for.hpp"
 #include "ulc/core/lidar_sequence.hpp"
 
 namespace hots {
@@ -80,7 +80,7 @@ namespace hots {
 /// The share of refine done after each of its phases, for a progress bar: the phases' shares of
 /// HOTS's time on the 60 s 64-32 drive (docs/experiments/long_drives.md: prepare 6 %, hierarchy
 /// 35 %, cross links 27 %, graph and synchronisation 1 %, whole-sequence step 31 %).
-using RefineProgress = std::function<void(double share)>;
+using RefineProgress = ulc::StepProgress;
 
 /// See the header comment. a and b are LidarSequences with their odometry poses; S is the
 /// scalar of the prepared point clouds (float is plenty). progress (optional) is called on the
@@ -110,9 +110,8 @@ RefineResult refine(const SeqA& a, const SeqB& b, const Isometry3d& extrinsic,
   auto done = [&progress](double share) {
     if (progress) progress(share);
   };
-  // A phase's own fraction f, as the share of refine done: from + (to - from) f.
-  auto within = [&done](double from, double to) {
-    return [&done, from, to](double f) { done(from + (to - from) * f); };
+  auto within = [&progress](double from, double to) {
+    return ulc::progress_within(progress, from, to);
   };
   d::prepare_lidars(a, b, s, options, st, within(0.0, 0.06));
   done(0.06);

@@ -245,10 +245,10 @@ void prepare_lidars(const SeqA& seq_a, const SeqB& seq_b, RefineState<S>& s,
   for (const auto& T : s.b.odometry) s.b.world.push_back(s.mapa_mapb * T);
   s.a.frames = prepare_frames<S>(seq_a.frames, s.a.times, s.a.odometry, options.frame_voxel,
                                  parts > 1 ? &s.a.sweeps : nullptr, parts,
-                                 [&](double f) { progress(share_a * f); });
+                                 ulc::progress_within(progress, 0.0, share_a));
   s.b.frames = prepare_frames<S>(seq_b.frames, s.b.times, s.b.odometry, options.frame_voxel,
                                  parts > 1 ? &s.b.sweeps : nullptr, parts,
-                                 [&](double f) { progress(share_a + (1.0 - share_a) * f); });
+                                 ulc::progress_within(progress, share_a, 1.0));
   st.prepare_seconds = lap(s.clock);
 }
 
@@ -261,10 +261,10 @@ void build_hierarchies(RefineState<S>& s, const RefineOptions& options, RefineSt
   const double share_a = share_of_a(s.a.frames.size(), s.b.frames.size());
   for (RefineLidar<S>* l : {&s.a, &s.b}) {
     const bool parts = options.hierarchy.sweep_parts > 1;
-    const double from = l == &s.a ? 0.0 : share_a, width = l == &s.a ? share_a : 1.0 - share_a;
+    const bool is_a = l == &s.a;
     l->hierarchy =
         build_hierarchy(l->frames, l->world, options.hierarchy, parts ? &l->sweeps : nullptr,
-                        [&](double f) { progress(from + width * f); });
+                        ulc::progress_within(progress, is_a ? 0.0 : share_a, is_a ? share_a : 1.0));
   }
   for (RefineLidar<S>* l : {&s.a, &s.b})
     if (options.boundary_bridges)
@@ -511,7 +511,7 @@ bool sequence_step(RefineState<S>& s, const RefineOptions& options, RefineResult
   const double start_dt = result.time_offset_s;
   st.sequence = sequence_extrinsic(s.a.hierarchy, s.a.frames, s.a.times, graph_poses(s, s.a),
                                    s.b.frames, s.b.times, result.extrinsic, result.time_offset_s,
-                                   so, [&](double f) { progress(0.8 * f); });
+                                   so, ulc::progress_within(progress, 0.0, 0.8));
   if (!st.sequence.ok()) {
     result.reason = st.sequence.reason;
     return false;
@@ -528,7 +528,7 @@ bool sequence_step(RefineState<S>& s, const RefineOptions& options, RefineResult
     const Vec6d moved = ulc::se3_log(Isometry3d(graph_answer * result.extrinsic.inverse()));
     result.covariance_6x6 = st.sequence.covariance_6x6 + moved * moved.transpose();
     const Vec6d rerun = rerun_from_start(s, so, start_dt, result.covariance_6x6, result,
-                                         [&](double f) { progress(0.8 + 0.2 * f); });
+                                         ulc::progress_within(progress, 0.8, 1.0));
     result.covariance_6x6 += rerun * rerun.transpose();
   }
   st.sequence_seconds =

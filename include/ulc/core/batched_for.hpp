@@ -25,6 +25,13 @@ namespace ulc {
 /// step (a Python hook raising KeyboardInterrupt).
 using StepProgress = std::function<void(double fraction)>;
 
+/// A part of a step as the whole step's progress: the part's own fraction f reported as
+/// from + (to - from) f; empty when `progress` is.
+inline StepProgress progress_within(const StepProgress& progress, double from, double to) {
+  if (!progress) return {};
+  return [progress, from, to](double f) { progress(from + (to - from) * f); };
+}
+
 /// Items per batch: a few per thread of the current arena, so a batch's last items keep only a
 /// small share of the threads waiting.
 inline std::size_t default_batch_size() {
