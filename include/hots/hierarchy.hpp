@@ -156,6 +156,17 @@ struct WindowEntries {
   std::vector<Isometry3d> poses;
 };
 
+/// One entry per member, its whole cloud (poses left for the caller).
+template <typename S>
+WindowEntries<S> member_entries(const WindowMembers<S>& wm) {
+  WindowEntries<S> e;
+  for (std::size_t m = 0; m < wm.clouds.size(); ++m) {
+    e.spans.emplace_back(*wm.clouds[m]);
+    e.member.push_back(m);
+  }
+  return e;
+}
+
 /// The window's BA (rigid, or over its sweeps' parts at a continuous layer 0) into o, and the
 /// submap's entries with their poses.
 template <typename S>
@@ -164,8 +175,6 @@ WindowEntries<S> window_ba_entries(const WindowMembers<S>& wm,
                                    std::size_t last, const Isometry3d* next_pose,
                                    const HierarchyOptions& options, WindowOutcome<S>& o) {
   WindowEntries<S> e;
-  for (const auto* c : wm.clouds) e.spans.emplace_back(*c);
-  for (std::size_t m = 0; m < wm.clouds.size(); ++m) e.member.push_back(m);
   std::size_t knots = wm.clouds.size();
   if (sweeps) {
     const SweepWindow<ulc::PointSpan<S>> sw = sweep_window(*sweeps, first, last, options.end_knot);
@@ -174,11 +183,11 @@ WindowEntries<S> window_ba_entries(const WindowMembers<S>& wm,
     knots = knot_poses.size();
     SweepBaResult sr = sweep_window_ba(sw, knot_poses, options.ba);
     o.ba = std::move(sr.ba);
-    e.spans.clear();
     for (const ulc::PointSpan<S>* part : sw.clouds) e.spans.push_back(*part);
     e.member = sw.sweep;
     e.poses = std::move(sr.entry_poses);
   } else {
+    e = member_entries(wm);
     o.ba = window_ba(wm.clouds, wm.poses, options.ba);
     e.poses = o.ba.poses;
   }
@@ -238,8 +247,7 @@ WindowOutcome<S> run_window(const std::vector<std::vector<ulc::Vec3<S>>>& frames
     const Isometry3d* next = last < poses.size() ? &poses[last] : nullptr;
     e = window_ba_entries(wm, continuous ? sweeps : nullptr, first, last, next, options, o);
   } else {
-    for (const auto* c : wm.clouds) e.spans.emplace_back(*c);
-    e.member.assign(1, 0);
+    e = member_entries(wm);
   }
   if (o.information.empty()) {  // no usable BA: keep the start
     o.ba.poses = wm.poses;
