@@ -45,13 +45,16 @@ Frames read_frames(const std::string& dir) {
   return out;
 }
 
-/// A progress hook that keeps the longest time between two calls (from the call's start).
+/// A progress hook that counts its calls and keeps the longest time between two of them (the
+/// first counted from `last`, the call's start).
 struct LongestWait {
-  Clock::time_point last = Clock::now();
+  Clock::time_point last;
   double seconds = 0.0;
   std::string where;
+  std::size_t calls = 0;
 
   void operator()(const std::string& stage, double fraction) {
+    ++calls;
     const Clock::time_point now = Clock::now();
     const double wait = std::chrono::duration<double>(now - last).count();
     if (wait > seconds) {
@@ -69,12 +72,8 @@ void bench(const Config& c) {
   tbb::task_arena arena(c.threads);
   for (int k = 0; k < c.bench.repeats; ++k) {
     LongestWait wait;
-    std::size_t calls = 0;
     ulc::CalibrateOptions o;
-    o.progress = [&](const std::string& stage, double fraction) {
-      ++calls;
-      wait(stage, fraction);
-    };
+    o.progress = [&wait](const std::string& stage, double fraction) { wait(stage, fraction); };
     const Clock::time_point t0 = Clock::now();
     wait.last = t0;
     const ulc::PairCalibration r =
@@ -82,7 +81,7 @@ void bench(const Config& c) {
     const double call_s = std::chrono::duration<double>(Clock::now() - t0).count();
     table.add_row({Cell::integer(k), ulc::to_string(r.status), Cell::num(call_s, 2),
                    Cell::num(wait.seconds, 2), wait.where,
-                   Cell::integer(static_cast<long long>(calls))});
+                   Cell::integer(static_cast<long long>(wait.calls))});
   }
   ulc_bench::emit(std::cout, table, c.bench.json, "progress", 1,
                   {{"base", c.base}, {"target", c.target}, {"threads", Cell::integer(c.threads)}},
