@@ -1,8 +1,8 @@
 // How a long C++ call behaves from Python: the GIL is released while it works, so other Python
 // threads run; the pipeline's progress hook (CalibrateOptions::progress, called on the calling
 // thread between steps: every TERRA search stage, JEEP round, odometry frame pair, HOTS phase,
-// and every few windows of HOTS's hierarchies and links of its cross links) takes the GIL back
-// briefly to
+// and within HOTS's phases every few frames, windows or cross links and each sub-step of its
+// whole-sequence step) takes the GIL back briefly to
 //   - check for signals (PyErr_CheckSignals): Ctrl-C raises KeyboardInterrupt there, and the
 //     C++ call unwinds at once (the exception leaves through the pipeline, which holds no
 //     resource it does not release on unwinding);
