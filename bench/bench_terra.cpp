@@ -9,7 +9,8 @@
 //                             [--alpha 2] [--threads 2] [--json]
 //   ./build/bench/bench_terra --maps [--pairs 64-tele,...] [--starts 8] [--spacing 3]
 //                             [--window 2] [--decimation 1] [--below-mask 100] [--seed 1]
-//                             [--threads 2] [--json]
+//                             [--no-motion] [--threads 2] [--json]
+//   ./build/bench/bench_terra --windows [--seed 1] [--pairs ...] [--starts 50] [--no-motion]
 //
 // Speed mode scenes: the synthetic crossroads of the tests (a 100k-point frame of an 80-beam
 // LiDAR, and a 32-beam target turned and 0.5 m away), and a simulated 64-32 frame pair
@@ -23,7 +24,13 @@
 // Maps mode: for each pair scenario, --starts windows of --window seconds spread along a drive,
 // the target's frames turned by a uniform random rotation per window; ulc::calibrate_pair
 // (terra stage alone) with terra_source frames, maps and automatic on the same windows.
-// Success: e_rot < 5 deg (also < 10 deg); a failed search counts as 180 deg.
+// Success: e_rot < 5 deg (also < 10 deg); a failed search counts as 180 deg. --no-motion turns
+// the motion frame (pipeline/motion_frame.hpp) off, for the comparison.
+//
+// Windows mode (--windows), issue 34's protocol: the eight pairs of the paper's TERRA figure,
+// 50 windows starting 1 s apart (from 1 s on) of --window seconds (default 2, the issue's cap;
+// the pipeline's default map window is 4), frames and automatic as in maps mode, and
+// scancontext* on each window's first frame pair.
 #include <tbb/task_arena.h>
 #include <Eigen/Core>
 #include <algorithm>
@@ -471,6 +478,10 @@ struct MapsOptions {
   unsigned decimation = 1;
   int threads = 2;
   std::size_t below_mask = ulc::CalibrateOptions().tuning.terra_source.maps_below_mask;
+  std::vector<ulc::TerraSource> sources = {ulc::TerraSource::frames, ulc::TerraSource::maps,
+                                           ulc::TerraSource::automatic};
+  bool motion = true;         ///< the motion frame on (MapTerraOptions::motion)
+  bool scan_context = false;  ///< a scancontext* row on each window's first frames
 };
 
 /// One start: the window's frames of each LiDAR from the start on (target turned by Q).
@@ -570,13 +581,101 @@ std::vector<Window> simulated_windows(const std::string& name, const MapsOptions
   return out;
 }
 
+/// One source's outcome over the windows of a pair.
+struct SourceTally {
+  std::vector<double> errors, masks;
+  double seconds = 0.0;
+  std::size_t ok5 = 0, ok10 = 0, chose_maps = 0, motion_used = 0, motion_ok = 0;
+
+  void add(double error_deg, double mask, double s) {
+    errors.push_back(error_deg);
+    masks.push_back(mask);
+    ok5 += error_deg < 5.0;
+    ok10 += error_deg < ulc::kRotationInitMaxRotationDeg;
+    seconds += s;
+  }
+};
+
+/// The terra stage alone on one window with `source`.
+ulc::PairCalibration terra_on_window(const Window& w, ulc::TerraSource source,
+                                     const MapsOptions& mo) {
+  ulc::CalibrateOptions co;
+  co.stages = {ulc::Stage::terra};
+  co.tuning.terra_source.source = source;
+  co.tuning.terra_source.maps.window_s = mo.window_s;
+  co.tuning.terra_source.maps.motion.enabled = mo.motion;
+  co.tuning.terra_source.maps_below_mask = mo.below_mask;
+  return in_arena(mo.threads, [&] {
+    return ulc::calibrate_pair(w.base, w.base_times, w.target, w.target_times, co);
+  });
+}
+
+void log_window(const std::string& name, std::size_t k, const char* label, double err,
+                const ulc::PairCalibration& r) {
+  const auto& t = r.terra;
+  std::cerr << name << " start " << k << " " << label << ": e_rot " << fmt(err, 2) << " deg, mask "
+            << (t ? t->mask_count : 0) << ", source "
+            << (t ? std::string(ulc::to_string(t->source)) : std::string("-")) << ", motion "
+            << (t && t->motion
+                    ? (t->motion->ok ? (t->motion->used ? "used" : "agrees") : t->motion->reason)
+                    : std::string("-"))
+            << ", " << fmt(r.timing_s.terra, 2) << " s\n";
+}
+
+SourceTally run_source(const std::string& name, const std::vector<Window>& windows,
+                       ulc::TerraSource source, const char* label, const MapsOptions& mo,
+                       bool log) {
+  SourceTally tally;
+  for (std::size_t k = 0; k < windows.size(); ++k) {
+    const Window& w = windows[k];
+    const ulc::PairCalibration r = terra_on_window(w, source, mo);
+    const double e = r.terra ? ulc::rotation_error_rad(w.truth, r.terra->rotation) / kDeg : 180.0;
+    const double err = r.success ? e : 180.0;
+    tally.add(err, r.terra ? double(r.terra->mask_count) : 0.0, r.timing_s.terra);
+    tally.chose_maps += r.terra && r.terra->source == ulc::TerraSource::maps;
+    tally.motion_ok += r.terra && r.terra->motion && r.terra->motion->ok;
+    tally.motion_used += r.terra && r.terra->motion && r.terra->motion->used;
+    if (log) log_window(name, k, label, err, r);
+  }
+  return tally;
+}
+
+/// scancontext* on each window's first frame pair (the target's frame turned as the window's).
+SourceTally run_scan_context(const std::vector<Window>& windows) {
+  SourceTally tally;
+  for (const Window& w : windows) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const auto sc = terra::scan_context_rotation(w.base.front(), w.target.front());
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    tally.add(sc.ok ? ulc::rotation_error_rad(w.truth, sc.rotation) / kDeg : 180.0, 0.0, s);
+  }
+  return tally;
+}
+
+std::string source_note(ulc::TerraSource source, const SourceTally& t, std::size_t n,
+                        const std::string& error) {
+  std::string note;
+  if (source == ulc::TerraSource::automatic)
+    note = "maps chosen " + std::to_string(t.chose_maps) + "/" + std::to_string(n);
+  if (source != ulc::TerraSource::frames)
+    note += std::string(note.empty() ? "" : "; ") + "motion ok " + std::to_string(t.motion_ok) +
+            ", used " + std::to_string(t.motion_used);
+  if (!error.empty()) note += (note.empty() ? "" : "; ") + error;
+  return note;
+}
+
+void add_tally_row(ulc_bench::Table& table, const std::string& name, const char* label,
+                   const SourceTally& t, const std::string& note) {
+  const double n = double(t.errors.size());
+  table.add_row({name, label, Cell::integer(long(t.errors.size())),
+                 Cell::num(100.0 * double(t.ok5) / n, 1), Cell::num(100.0 * double(t.ok10) / n, 1),
+                 Cell::num(median(t.errors), 2), Cell::num(median(t.masks), 0),
+                 Cell::num(t.seconds / n, 2), note});
+}
+
 int run_maps(const ulc_bench::Options& options, const MapsOptions& mo) {
   ulc_bench::Table table({"pair", "source", "starts", "success_5deg_pct", "success_10deg_pct",
                           "median_deg", "median_mask", "mean_s", "note"});
-  const std::vector<std::pair<const char*, ulc::TerraSource>> sources = {
-      {"frames", ulc::TerraSource::frames},
-      {"maps", ulc::TerraSource::maps},
-      {"automatic", ulc::TerraSource::automatic}};
   for (const std::string& name : mo.pairs) {
     std::string error;
     const auto windows = simulated_windows(name, mo, error);
@@ -584,58 +683,13 @@ int run_maps(const ulc_bench::Options& options, const MapsOptions& mo) {
       table.add_row({name, "", "0", "", "", "", "", "", error});
       continue;
     }
-    for (const auto& [label, source] : sources) {
-      std::vector<double> errors, masks;
-      double seconds = 0;
-      std::size_t ok5 = 0, ok10 = 0, chose_maps = 0;
-      for (std::size_t k = 0; k < windows.size(); ++k) {
-        const Window& w = windows[k];
-        ulc::CalibrateOptions co;
-        co.stages = {ulc::Stage::terra};
-        co.tuning.terra_source.source = source;
-        co.tuning.terra_source.maps.window_s = mo.window_s;
-        co.tuning.terra_source.maps_below_mask = mo.below_mask;
-        const auto r = in_arena(mo.threads, [&] {
-          return ulc::calibrate_pair(w.base, w.base_times, w.target, w.target_times, co);
-        });
-        const double e =
-            r.terra ? ulc::rotation_error_rad(w.truth, r.terra->rotation) / kDeg : 180.0;
-        const double err = r.success ? e : 180.0;
-        errors.push_back(err);
-        masks.push_back(r.terra ? double(r.terra->mask_count) : 0.0);
-        ok5 += err < 5.0;
-        ok10 += err < ulc::kRotationInitMaxRotationDeg;
-        seconds += r.timing_s.terra;
-        const bool maps = r.terra && r.terra->source == ulc::TerraSource::maps;
-        chose_maps += maps;
-        if (!options.json)
-          std::cerr << name << " start " << k << " " << label << ": e_rot " << fmt(err, 2)
-                    << " deg, mask " << (r.terra ? r.terra->mask_count : 0) << ", frames mask "
-                    << (r.terra && r.terra->frames_mask_count
-                            ? std::to_string(*r.terra->frames_mask_count)
-                            : std::string("-"))
-                    << ", source "
-                    << (r.terra ? std::string(ulc::to_string(r.terra->source)) : std::string("-"))
-                    << ", map pts "
-                    << (r.terra && r.terra->base_map ? r.terra->base_map->points : 0) << "/"
-                    << (r.terra && r.terra->target_map ? r.terra->target_map->points : 0)
-                    << ", odo "
-                    << (r.terra && r.terra->target_map
-                            ? std::string(odometry::to_string(r.terra->base_map->odometry_status)) +
-                                  "/" + odometry::to_string(r.terra->target_map->odometry_status)
-                            : std::string("-"))
-                    << ", " << fmt(r.timing_s.terra, 2) << " s\n";
-      }
-      const double n = double(windows.size());
-      std::string note = error;
-      if (source == ulc::TerraSource::automatic)
-        note = "maps chosen " + std::to_string(chose_maps) + "/" + std::to_string(windows.size()) +
-               (error.empty() ? "" : "; " + error);
-      table.add_row({name, label, Cell::integer(long(windows.size())),
-                     Cell::num(100.0 * double(ok5) / n, 1), Cell::num(100.0 * double(ok10) / n, 1),
-                     Cell::num(median(errors), 2), Cell::num(median(masks), 0),
-                     Cell::num(seconds / n, 2), note});
+    for (const ulc::TerraSource source : mo.sources) {
+      const char* label = ulc::to_string(source);
+      const SourceTally t = run_source(name, windows, source, label, mo, !options.json);
+      add_tally_row(table, name, label, t, source_note(source, t, windows.size(), error));
     }
+    if (mo.scan_context)
+      add_tally_row(table, name, "scancontext*", run_scan_context(windows), "first frames");
   }
   const ulc_bench::Machine m = ulc_bench::machine();
   if (options.json) {
@@ -646,12 +700,14 @@ int run_maps(const ulc_bench::Options& options, const MapsOptions& mo) {
                       {"window_s", Cell::num(mo.window_s, 2)},
                       {"decimation", Cell::integer(long(mo.decimation))},
                       {"below_mask", Cell::integer(long(mo.below_mask))},
+                      {"motion_frame", mo.motion ? "on" : "off"},
                       {"threads", Cell::integer(mo.threads)},
                       {"success", "e_rot < 5 deg (and < 10 deg)"}});
   } else {
     std::cout << "bench_terra --maps: " << mo.starts << " starts " << mo.spacing_s
               << " s apart, window " << mo.window_s << " s, target turned by a uniform random "
-              << "rotation per start; a failed search counts as 180 deg\n\n";
+              << "rotation per start; motion frame " << (mo.motion ? "on" : "off")
+              << "; a failed search counts as 180 deg\n\n";
     table.print(std::cout);
   }
   return 0;
@@ -660,7 +716,7 @@ int run_maps(const ulc_bench::Options& options, const MapsOptions& mo) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  bool accuracy = false, maps = false;
+  bool accuracy = false, maps = false, windows = false;
   AccuracyOptions acc;
   MapsOptions mo;
   CLI::App app(
@@ -671,12 +727,19 @@ int main(int argc, char** argv) {
   ulc_bench::add_options(app, options);
   app.add_flag("--accuracy", accuracy, "TERRA against scancontext* on simulated rig pairs");
   app.add_flag("--maps", maps, "TERRA on frames against local maps");
+  app.add_flag("--windows", windows,
+               "issue 34's protocol: the eight paper pairs, 50 windows of 2 s, 1 s apart; frames, "
+               "automatic and scancontext*");
+  app.add_flag_callback(
+      "--no-motion", [&] { mo.motion = false; }, "--maps/--windows: the motion frame off");
   app.add_option("--starts", mo.starts, "--maps: windows per pair (default 8)")
       ->type_name("N")
       ->check(CLI::PositiveNumber);
   app.add_option("--spacing", mo.spacing_s, "--maps: seconds between windows (default 3)")
       ->type_name("S");
-  app.add_option("--window", mo.window_s, "--maps: seconds per window (default 2)")->type_name("S");
+  app.add_option("--window", mo.window_s,
+                 "--maps: seconds per window (default: the pipeline's, 4; --windows: 2)")
+      ->type_name("S");
   app.add_option("--decimation", mo.decimation, "--maps: keep every Nth point (default 1)")
       ->type_name("N")
       ->check(CLI::PositiveNumber);
@@ -713,7 +776,16 @@ int main(int argc, char** argv) {
   ulc_bench::add_threads_option(app, acc.threads);
   CLI11_PARSE(app, argc, argv);
   const bool pairs_given = pairs_option->count() > 0;
-  if (maps) {
+  if (windows) {
+    mo.pairs = {"64-32",   "32-16",        "64-horizon", "32-avia",
+                "64-tele", "horizon-tele", "16-tele",    "32-mid40"};
+    if (app.count("--starts") == 0) mo.starts = 50;
+    if (app.count("--spacing") == 0) mo.spacing_s = 1.0;
+    if (app.count("--window") == 0) mo.window_s = 2.0;
+    mo.sources = {ulc::TerraSource::frames, ulc::TerraSource::automatic};
+    mo.scan_context = true;
+  }
+  if (maps || windows) {
     if (pairs_given) mo.pairs = acc.pairs;
     mo.seed = acc.seed;
     mo.threads = acc.threads;

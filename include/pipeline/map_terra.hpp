@@ -19,6 +19,9 @@
 //   - An odometry that could not register some frames (registration_failed) still gives a
 //     map (its poses are predictions there; the statistics count the failures); one that gives
 //     no poses ends the call with the search status invalid_input and the reason.
+//   - The motion frame (motion_frame.hpp, MapTerraOptions::motion): each map's travel over the
+//     window (first to last frame, in the anchor frame) and largest planes give a rotation of
+//     their own, reported beside the search's; the TERRA stage (terra_stage.hpp) decides.
 //   - Deterministic for any thread count (odometry, voxel thinning and search all are).
 //   - Nothing here throws, exits or prints; it compiles with -fno-exceptions.
 #pragma once
@@ -35,6 +38,7 @@
 #include "odometry/run_odometry.hpp"
 #include "odometry/scan_preparation.hpp"
 #include "pipeline/map_terra_options.hpp"
+#include "pipeline/motion_frame.hpp"
 #include "terra/lattice.hpp"
 #include "terra/search.hpp"
 #include "ulc/core/point_cloud.hpp"
@@ -46,13 +50,15 @@ namespace ulc {
 
 template <typename S>
 struct LocalMap {
-  std::vector<Vec3<S>> points;  ///< in the LiDAR's frame at the anchor frame
+  std::vector<Vec3<S>> points;   ///< in the LiDAR's frame at the anchor frame
+  Vec3d travel = Vec3d::Zero();  ///< the window's first to last position, in the anchor frame
   LocalMapStats stats;
   bool ok = false;  ///< the odometry gave poses (else points is empty and stats say why)
 };
 
 struct MapTerraResult {
   terra::SearchResult search;  ///< R_base_target between the maps' frames
+  MotionReport motion;         ///< the maps' ground and travel (motion_frame.hpp), when enabled
   LocalMapStats base, target;
   double seconds = 0.0;  ///< maps and search
   bool ok() const { return search.ok(); }
@@ -129,8 +135,12 @@ auto build_local_map(const Frames& frames, const std::vector<double>& times, std
     for (const auto& p : scan.dense)
       stack.points.push_back((step.pose_a * p.template cast<double>()).template cast<S>());
   }
+  const Isometry3d& first_pose = odo.steps.front().pose_a;
+  const Isometry3d& last_pose = odo.steps.back().pose_a;
+  const Isometry3d& anchor = options.anchor == MapAnchor::last_frame ? last_pose : first_pose;
+  map.travel = anchor.linear().transpose() * (last_pose.translation() - first_pose.translation());
   if (options.anchor == MapAnchor::last_frame) {
-    const Isometry3d to_last = odo.steps.back().pose_a.inverse();
+    const Isometry3d to_last = last_pose.inverse();
     for (auto& p : stack.points) p = (to_last * p.template cast<double>()).template cast<S>();
   }
   map.stats.stacked_points = stack.points.size();
@@ -149,8 +159,75 @@ auto build_local_map(const Frames& frames, const std::vector<double>& times, std
   return map;
 }
 
-/// TERRA on the two LiDARs' local maps from frame `first` of each (see the conventions above).
-/// `lattice` must have params.lattice_size points (reuse one across calls when you can).
+/// Both LiDARs' local maps over their windows and the motion frame they give, before any search.
+template <typename SA, typename SB>
+struct LocalMaps {
+  LocalMap<SA> a;
+  LocalMap<SB> b;
+  MotionReport motion;  ///< not ok (with the reason) when a map failed or motion is disabled
+  double seconds = 0.0;
+  bool ok() const { return a.ok && b.ok; }
+};
+
+/// The local maps of both LiDARs from frame `first` of each, and their motion frame.
+/// progress (optional) gets the share done: 0.5 after the base's map, 1 at the end.
+template <class FramesA, class FramesB>
+auto build_local_maps(const FramesA& frames_a, const std::vector<double>& times_a,
+                      const FramesB& frames_b, const std::vector<double>& times_b,
+                      std::size_t first, const MapTerraOptions& options = {},
+                      const std::function<void(double)>& progress = {}) {
+  const auto t0 = std::chrono::steady_clock::now();
+  auto a = build_local_map(frames_a, times_a, first, options);
+  if (progress) progress(0.5);
+  auto b = build_local_map(frames_b, times_b, first, options);
+  LocalMaps<typename decltype(a.points)::value_type::Scalar,
+            typename decltype(b.points)::value_type::Scalar>
+      maps{std::move(a), std::move(b), {}, 0.0};
+  if (!maps.ok())
+    maps.motion.reason = "a local map could not be built";
+  else if (options.motion.enabled)
+    maps.motion =
+        motion_rotation(motion_view(maps.a.points, maps.a.travel, options.motion),
+                        motion_view(maps.b.points, maps.b.travel, options.motion), options.motion);
+  else
+    maps.motion.reason = "the motion frame is disabled (MapTerraOptions::motion)";
+  maps.seconds = map_terra_detail::seconds_since(t0);
+  if (progress) progress(1.0);
+  return maps;
+}
+
+/// TERRA's search on built local maps (d1 = MapTerraOptions::d1 when set). `lattice` must have
+/// params.lattice_size points.
+template <typename SA, typename SB>
+MapTerraResult search_local_maps(const terra::Lattice& lattice, const LocalMaps<SA, SB>& maps,
+                                 const terra::SearchParams& params = {},
+                                 const MapTerraOptions& options = {}) {
+  const auto t0 = std::chrono::steady_clock::now();
+  MapTerraResult r;
+  r.base = maps.a.stats;
+  r.target = maps.b.stats;
+  r.motion = maps.motion;
+  if (!maps.ok()) {
+    const LocalMapStats& bad = maps.a.ok ? r.target : r.base;
+    r.search.status = terra::SearchStatus::invalid_input;
+    r.search.reason = std::string(maps.a.ok ? "target" : "base") + " local map: odometry " +
+                      odometry::to_string(bad.odometry_status) + ": " + bad.odometry_reason;
+  } else {
+    terra::SearchParams p = params;
+    p.progress = {};
+    if (options.d1 > 0.0) {
+      p.distance.d1 = options.d1;
+      p.adaptive_d1.enabled = false;
+    }
+    r.search = terra::estimate_rotation(lattice, maps.a.points, maps.b.points, p);
+  }
+  r.seconds = maps.seconds + map_terra_detail::seconds_since(t0);
+  return r;
+}
+
+/// TERRA on the two LiDARs' local maps from frame `first` of each (see the conventions above):
+/// build_local_maps, then search_local_maps. `lattice` must have params.lattice_size points
+/// (reuse one across calls when you can).
 template <class FramesA, class FramesB>
 MapTerraResult map_terra(const terra::Lattice& lattice, const FramesA& frames_a,
                          const std::vector<double>& times_a, const FramesB& frames_b,
@@ -158,35 +235,13 @@ MapTerraResult map_terra(const terra::Lattice& lattice, const FramesA& frames_a,
                          const terra::SearchParams& params = {},
                          const MapTerraOptions& options = {},
                          const std::function<void(double)>& progress = {}) {
-  const auto t0 = std::chrono::steady_clock::now();
-  auto report = [&](double f) {
-    if (progress) progress(f);
-  };
-  MapTerraResult r;
-  report(0.0);
-  const auto map_a = build_local_map(frames_a, times_a, first, options);
-  r.base = map_a.stats;
-  report(0.4);
-  const auto map_b = build_local_map(frames_b, times_b, first, options);
-  r.target = map_b.stats;
-  report(0.8);
-  if (!map_a.ok || !map_b.ok) {
-    const LocalMapStats& bad = map_a.ok ? r.target : r.base;
-    r.search.status = terra::SearchStatus::invalid_input;
-    r.search.reason = std::string(map_a.ok ? "target" : "base") + " local map: odometry " +
-                      odometry::to_string(bad.odometry_status) + ": " + bad.odometry_reason;
-    r.seconds = map_terra_detail::seconds_since(t0);
-    return r;
-  }
-  terra::SearchParams p = params;
-  p.progress = {};
-  if (options.d1 > 0.0) {
-    p.distance.d1 = options.d1;
-    p.adaptive_d1.enabled = false;
-  }
-  r.search = terra::estimate_rotation(lattice, map_a.points, map_b.points, p);
-  r.seconds = map_terra_detail::seconds_since(t0);
-  report(1.0);
+  std::function<void(double)> building;
+  if (progress) building = [&progress](double f) { progress(0.8 * f); };
+  if (progress) progress(0.0);
+  const auto maps =
+      build_local_maps(frames_a, times_a, frames_b, times_b, first, options, building);
+  MapTerraResult r = search_local_maps(lattice, maps, params, options);
+  if (progress) progress(1.0);
   return r;
 }
 

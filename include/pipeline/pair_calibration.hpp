@@ -79,7 +79,8 @@ inline const char* to_string(CalibrateStatus s) {
 /// One of TERRA's hypotheses the pipeline started from (terra_hypotheses.hpp) and what became of
 /// it.
 struct TerraHypothesis {
-  TerraSource source = TerraSource::frames;      ///< frames or maps: the search it is an optimum of
+  TerraSource source = TerraSource::frames;  ///< frames or maps: the search it is an optimum of
+  bool motion = false;  ///< the motion frame's rotation (terra_stage.hpp), not a search optimum
   Mat3d rotation = Mat3d::Identity();            ///< R_base_target
   double distance = 0.0;                         ///< eq:feature_dis
   std::size_t mask_count = 0;                    ///< eq:mask cells
@@ -109,7 +110,11 @@ struct TerraReport {
   /// keeps it unless its overlap is small), whatever source was kept.
   std::optional<std::size_t> frames_mask_count;
   terra::SearchStatus frames_status = terra::SearchStatus::ok;
-  std::optional<LocalMapStats> base_map, target_map;  ///< when the map search ran
+  std::optional<LocalMapStats> base_map, target_map;  ///< when the maps were built
+  /// The maps' ground and travel (motion_frame.hpp), when the maps were built; when it
+  /// overruled the search (motion->used), `rotation` is its rotation and the fields above
+  /// `source` describe the search it overruled.
+  std::optional<MotionReport> motion;
   /// The hypotheses the later stages started from, in the order tried (the first is the
   /// search's best, `rotation`), and the index of the one the result comes from (the first
   /// when none succeeded).

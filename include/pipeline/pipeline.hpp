@@ -180,7 +180,7 @@ std::optional<StartRotations> terra_step(const FA& frames_a, const std::vector<d
   notify(options, "terra", 1.0);  // the map search may not have run after the frames' share
   r.timing_s.terra = report.seconds;
   r.terra = std::move(report);
-  if (!searches.kept.ok()) return std::nullopt;
+  if (!searches.ok()) return std::nullopt;
   return start_rotations(searches, r.terra->source, options.tuning.hypotheses);
 }
 
@@ -201,6 +201,7 @@ PairCalibration try_hypotheses(const AttemptInputs<FA, FB>& in, const StartRotat
     const std::string label = k == 0 ? "" : " (hypothesis " + std::to_string(k + 1) + ")";
     const StageOutcome o = run_attempt(in, start, label, k < starts.first_fallback, attempt);
     TerraHypothesis entry = hypothesis_entry(starts.candidates[k], starts.sources[k]);
+    entry.motion = k == 0 && starts.motion_first;
     entry.status = o.status;
     entry.reason = o.reason;
     entry.seconds = seconds_since(t0);
@@ -261,6 +262,7 @@ inline PairCalibration terra_only(const StartRotations& starts, PairCalibration&
   r.T_base_target.linear() = starts.candidates.front().rotation;
   r.terra->hypotheses.push_back(
       hypothesis_entry(starts.candidates.front(), starts.sources.front()));
+  r.terra->hypotheses.back().motion = starts.motion_first;
   return finish(CalibrateStatus::ok, "");
 }
 

@@ -7,26 +7,37 @@
 //     maps_min_frames frames in the window AND the frame search failed or overlaps in fewer
 //     than maps_below_mask cells; the maps win when they succeed with a larger mask. The report
 //     says which search was kept ("source") and why.
-//   - Hypotheses (terra_hypotheses.hpp): the kept search's distinct optima, best first, then the
-//     fallback's (its remaining optima, then the other search's).
+//   - The motion frame (motion_frame.hpp; not in the paper): whenever the local maps are built
+//     (source maps, or automatic with enough frames in the window: built even when the frames
+//     overlap well, to check them), the maps' ground and travel give a rotation of their own.
+//     A kept answer within MotionFrameOptions::agree_deg of it stands (the paper's search
+//     where it works); a farther one, or a failed search, is overruled: the motion frame's
+//     rotation becomes the stage's answer and the first hypothesis. In automatic, frames that
+//     overlap well but disagree with the motion frame also bring the map search in.
+//   - Hypotheses (terra_hypotheses.hpp): the motion frame's rotation when it overruled, then the
+//     kept search's distinct optima, best first, then the fallback's (its remaining optima,
+//     then the other search's).
 //   - Progress: "terra" from 0 to 1; the frame search gets a fifth of the bar when maps may
-//     follow.
+//     follow, the maps' building the next 60 %.
 #pragma once
 
 #include <algorithm>
 #include <chrono>
 #include <cstddef>
 #include <functional>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "pipeline/map_terra.hpp"
+#include "pipeline/motion_frame.hpp"
 #include "pipeline/options.hpp"
 #include "pipeline/pair_calibration.hpp"
 #include "pipeline/terra_hypotheses.hpp"
 #include "terra/search.hpp"
 #include "ulc/core/point_traits.hpp"
+#include "ulc/core/pose_error.hpp"
 
 namespace ulc {
 namespace calibrate_detail {
@@ -63,11 +74,19 @@ struct TerraInputs {
   }
 };
 
-/// The kept search, and the one not kept when both ran (for the fallback hypotheses).
+/// The kept search, the one not kept when both ran (for the fallback hypotheses), and the
+/// motion frame when the maps were built.
 struct TerraSearches {
   terra::SearchResult kept;
   terra::SearchResult other;
+  std::optional<MotionReport> motion;
+  bool motion_used() const { return motion && motion->used; }
+  bool ok() const { return kept.ok() || motion_used(); }
 };
+
+inline void notify_terra(const CalibrateOptions& o, double fraction) {
+  if (o.progress) o.progress("terra", fraction);
+}
 
 template <class FA, class FB>
 terra::SearchResult search_frames(const TerraInputs<FA, FB>& in) {
@@ -80,18 +99,28 @@ terra::SearchResult search_frames(const TerraInputs<FA, FB>& in) {
              : terra::estimate_rotation(in.lattice, in.frames_a[i], in.frames_b[i], p);
 }
 
+/// Both LiDARs' local maps and their motion frame, on the bar after the frame search's share.
 template <class FA, class FB>
-MapTerraResult search_maps(const TerraInputs<FA, FB>& in) {
+auto build_maps(const TerraInputs<FA, FB>& in) {
   const CalibrateOptions& o = in.options;
   const double from = o.tuning.terra_source.source != TerraSource::maps ? in.frame_share : 0.0;
   std::function<void(double)> progress;
-  if (o.progress) progress = [&o, from](double f) { o.progress("terra", from + (1.0 - from) * f); };
-  const terra::SearchParams& params = o.tuning.terra;
-  const MapTerraOptions& maps = o.tuning.terra_source.maps;
-  return params.lattice_size < 2 ? map_terra(in.frames_a, in.times_a, in.frames_b, in.times_b,
-                                             o.frame_index, params, maps, progress)
-                                 : map_terra(in.lattice, in.frames_a, in.times_a, in.frames_b,
-                                             in.times_b, o.frame_index, params, maps, progress);
+  if (o.progress)
+    progress = [&o, from](double f) { o.progress("terra", from + 0.75 * (1.0 - from) * f); };
+  return build_local_maps(in.frames_a, in.times_a, in.frames_b, in.times_b, o.frame_index,
+                          o.tuning.terra_source.maps, progress);
+}
+
+template <class FA, class FB, class Maps>
+MapTerraResult search_maps(const TerraInputs<FA, FB>& in, const Maps& maps) {
+  const terra::SearchParams& params = in.options.tuning.terra;
+  const MapTerraOptions& options = in.options.tuning.terra_source.maps;
+  MapTerraResult r =
+      params.lattice_size < 2
+          ? search_local_maps(terra::Lattice(params.lattice_size), maps, params, options)
+          : search_local_maps(in.lattice, maps, params, options);
+  notify_terra(in.options, 1.0);
+  return r;
 }
 
 /// Statistics of a TERRA search, in the report's form.
@@ -136,22 +165,20 @@ TerraReport maps_report(const TerraInputs<FA, FB>& in, const MapTerraResult& m, 
   return t;
 }
 
-/// automatic, once the frame search `f` overlapped too little: the map search, kept when it
-/// succeeds with a larger mask.
-template <class FA, class FB>
+/// automatic, once the frame search `f` overlapped too little (or disagreed with the motion
+/// frame): the map search, kept when it succeeds with a larger mask.
+template <class FA, class FB, class Maps>
 TerraSearches frames_or_maps(const TerraInputs<FA, FB>& in, const terra::SearchResult& f,
+                             const Maps& maps, const std::string& frames_said,
                              TerraReport& report) {
-  const MapTerraResult m = search_maps(in);
-  const std::string frames_said =
-      f.ok() ? "the frames overlap in only " + std::to_string(f.mask_count) + " cells"
-             : std::string("the frame search failed (") + terra::to_string(f.status) + ")";
+  const MapTerraResult m = search_maps(in, maps);
   if (m.ok() && (!f.ok() || m.search.mask_count > f.mask_count)) {
     report = maps_report(
         in, m,
         "automatic: " + frames_said + "; the maps in " + std::to_string(m.search.mask_count));
     report.frames_mask_count = f.mask_count;
     report.frames_status = f.status;
-    return {m.search, f};
+    return {m.search, f, m.motion};
   }
   report = frames_report(
       in, f,
@@ -160,38 +187,90 @@ TerraSearches frames_or_maps(const TerraInputs<FA, FB>& in, const terra::SearchR
                   : std::string("failed: ") + m.search.reason));
   report.base_map = m.base;
   report.target_map = m.target;
-  return {f, m.search};
+  return {f, m.search, m.motion};
 }
 
-/// The search StageTuning::terra_source asks for; fills `report` (all but seconds).
+/// How far (deg) a search's answer lies from the motion frame's rotation (180 when it failed).
+inline double off_motion_deg(const terra::SearchResult& s, const MotionReport& m) {
+  return s.ok() ? rotation_error_rad(m.rotation, s.rotation) / kRadPerDeg : 180.0;
+}
+
+/// The motion frame's vote on the kept answer (see the conventions above), into the report.
+inline void motion_vote(TerraSearches& searches, const MotionFrameOptions& o, TerraReport& report) {
+  if (!searches.motion) return;
+  MotionReport& m = *searches.motion;
+  if (m.ok) {
+    m.search_off_deg = off_motion_deg(searches.kept, m);
+    m.used = m.search_off_deg > o.agree_deg;
+  }
+  if (m.used) {
+    if (!searches.kept.ok())
+      report.reason = "the search failed (" + report.reason + "); the motion frame stands in";
+    report.rotation = m.rotation;
+    report.status = terra::SearchStatus::ok;
+  }
+  report.motion = m;
+}
+
+/// automatic with the maps built: the frames kept when they overlap well and the motion frame
+/// does not contradict them, else the map search as well.
 template <class FA, class FB>
-TerraSearches run_terra_search(const TerraInputs<FA, FB>& in, TerraReport& report) {
+TerraSearches automatic_with_maps(const TerraInputs<FA, FB>& in, const terra::SearchResult& f,
+                                  TerraReport& report) {
+  const TerraSourceOptions& src = in.options.tuning.terra_source;
+  const auto maps = build_maps(in);
+  const bool overlap = f.ok() && f.mask_count >= src.maps_below_mask;
+  const bool contradicted =
+      maps.motion.ok && off_motion_deg(f, maps.motion) > src.maps.motion.agree_deg;
+  if (overlap && !contradicted) {
+    report = frames_report(in, f,
+                           "automatic: the frames overlap in " + std::to_string(f.mask_count) +
+                               " cells (maps are tried below " +
+                               std::to_string(src.maps_below_mask) + ")");
+    report.base_map = maps.a.stats;
+    report.target_map = maps.b.stats;
+    notify_terra(in.options, 1.0);
+    return {f, {}, maps.motion};
+  }
+  const std::string frames_said =
+      overlap ? "the frames overlap in " + std::to_string(f.mask_count) +
+                    " cells but disagree with the motion frame"
+      : f.ok() ? "the frames overlap in only " + std::to_string(f.mask_count) + " cells"
+               : std::string("the frame search failed (") + terra::to_string(f.status) + ")";
+  return frames_or_maps(in, f, maps, frames_said, report);
+}
+
+/// The searches StageTuning::terra_source asks for, before the motion frame's vote.
+template <class FA, class FB>
+TerraSearches run_searches(const TerraInputs<FA, FB>& in, TerraReport& report) {
   const TerraSourceOptions& src = in.options.tuning.terra_source;
   if (src.source == TerraSource::maps) {
-    const MapTerraResult m = search_maps(in);
+    const MapTerraResult m = search_maps(in, build_maps(in));
     report = maps_report(in, m, "terra_source = maps");
-    return {m.search, {}};
+    return {m.search, {}, m.motion};
   }
   const terra::SearchResult f = search_frames(in);
   if (src.source == TerraSource::frames) {
     report = frames_report(in, f, "terra_source = frames");
-    return {f, {}};
+    return {f, {}, std::nullopt};
   }
   if (!in.maps_possible) {
     report = frames_report(in, f,
                            "automatic: " + std::to_string(in.window) +
                                " frame(s) per LiDAR in the map window (maps need " +
                                std::to_string(src.maps_min_frames) + ")");
-    return {f, {}};
+    return {f, {}, std::nullopt};
   }
-  if (f.ok() && f.mask_count >= src.maps_below_mask) {
-    report = frames_report(in, f,
-                           "automatic: the frames overlap in " + std::to_string(f.mask_count) +
-                               " cells (maps are tried below " +
-                               std::to_string(src.maps_below_mask) + ")");
-    return {f, {}};
-  }
-  return frames_or_maps(in, f, report);
+  return automatic_with_maps(in, f, report);
+}
+
+/// The search StageTuning::terra_source asks for and the motion frame's vote; fills `report`
+/// (all but seconds).
+template <class FA, class FB>
+TerraSearches run_terra_search(const TerraInputs<FA, FB>& in, TerraReport& report) {
+  TerraSearches searches = run_searches(in, report);
+  motion_vote(searches, in.options.tuning.terra_source.maps.motion, report);
+  return searches;
 }
 
 /// The rotations the later stages start from, best first; `first_fallback` is the index of the
@@ -200,15 +279,28 @@ struct StartRotations {
   std::vector<terra::RotationCandidate> candidates;
   std::vector<TerraSource> sources;  ///< the search each candidate is an optimum of
   std::size_t first_fallback = 0;
+  bool motion_first = false;  ///< candidates[0] is the motion frame's rotation
 };
 
 inline StartRotations start_rotations(const TerraSearches& searches, TerraSource kept_source,
                                       const HypothesisOptions& o) {
   const double separation = o.separation_deg * kRadPerDeg;
+  const std::size_t count = std::max<std::size_t>(1, o.count);
   StartRotations out;
-  out.candidates = terra_hypotheses(searches.kept, std::max<std::size_t>(1, o.count), separation);
+  if (searches.motion_used()) {
+    terra::RotationCandidate c;
+    c.rotation = searches.motion->rotation;
+    c.distance = 0.0;  // not a search optimum: no eq:feature_dis
+    out.candidates.push_back(c);
+    out.sources.push_back(TerraSource::maps);
+    out.motion_first = true;
+    for (const auto& k : fallback_hypotheses(searches.kept, out.candidates, count - 1, separation))
+      out.candidates.push_back(k);
+  } else {
+    out.candidates = terra_hypotheses(searches.kept, count, separation);
+  }
   out.first_fallback = out.candidates.size();
-  out.sources.assign(out.candidates.size(), kept_source);
+  out.sources.resize(out.candidates.size(), kept_source);
   const TerraSource other_source =
       kept_source == TerraSource::maps ? TerraSource::frames : TerraSource::maps;
   for (const terra::SearchResult* search : {&searches.kept, &searches.other}) {

@@ -134,6 +134,11 @@ TEST_CASE("the fallback finds the 90-deg-pitched VLP-16 where the map search's o
   INFO(ulc::to_string(c.status) << ": " << c.reason);
   REQUIRE(c.terra);
   CHECK(c.terra->source == ulc::TerraSource::maps);
+  // The motion frame cannot help: the vertically spinning VLP-16's own odometry travels 10 m
+  // where the base travels 28 (measured), and the travel check refuses it.
+  REQUIRE(c.terra->motion);
+  CHECK_FALSE(c.terra->motion->ok);
+  CHECK_THAT(c.terra->motion->reason, Catch::Contains("disagree on the distance"));
   // This drive pins x loosely: HOTS's covariance puts its 3-sigma bound near 11 cm, so the
   // result may say `uncertain` (pipeline/confidence.hpp); the answer itself is checked below.
   REQUIRE((c.success || c.status == CalibrateStatus::uncertain));

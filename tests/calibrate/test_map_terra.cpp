@@ -10,6 +10,7 @@
 #include "calibrate_test_util.hpp"
 #include "pipeline/calibrate.hpp"
 #include "pipeline/map_terra.hpp"
+#include "terra/random_rotation.hpp"
 #include "ulc/core/pose_error.hpp"
 #include "ulc/io/result_entry.hpp"
 #include "ulc/sim/sim.hpp"
@@ -118,6 +119,46 @@ TEST_CASE("TERRA on 3 s local maps finds the 64-tele rotation that single frames
         static_cast<double>(automatic.terra->target_map->points));
 }
 
+TEST_CASE("the motion frame gives the 64-tele rotation from 2 s, whatever the mount",
+          "[calibrate][map_terra][motion_frame]") {
+  const auto& d = drive_64_tele();
+  const auto& a = d.lidars[0];
+  const auto& b = d.lidars[1];
+  const std::size_t i = start_index(d);
+  terra::SplitMix64 rng(11);
+  for (int k = 0; k < 2; ++k) {
+    // The Tele turned by a rotation uniform on SO(3): its points p become Q p.
+    const ulc::Mat3d Q = terra::random_rotation(rng);
+    std::vector<ulc::PointCloud<float>> turned = b.frames;
+    for (auto& f : turned)
+      for (auto& p : f.points) p = (Q * p.cast<double>()).cast<float>();
+    const ulc::Mat3d truth = d.pairs.at(0).T_base_target.linear() * Q.transpose();
+    ulc::CalibrateOptions o;
+    o.stages = {ulc::Stage::terra};
+    o.frame_index = i;
+    const auto c = ulc::calibrate_pair(a.frames, a.timestamps, turned, b.timestamps, o);
+    REQUIRE(c.success);
+    REQUIRE(c.terra->motion);
+    const ulc::MotionReport& m = *c.terra->motion;
+    INFO("motion: " << m.reason << ", search off by " << m.search_off_deg << " deg");
+    REQUIRE(m.ok);
+    CHECK(m.travel_base_m > 3.0);
+    CHECK(std::abs(m.travel_base_m - m.travel_target_m) < 0.1 * m.travel_base_m);
+    CHECK(m.planes_matched >= 1);
+    // The single frames' search misses (a chance match of a few cells: the test above); the
+    // motion frame overrules it, or the map search agrees with it.
+    CHECK(error_deg(truth, m.rotation) < 10.0);
+    CHECK(error_deg(truth, c.terra->rotation) < 10.0);
+    CHECK(c.T_base_target.linear() == c.terra->rotation);
+    CHECK(c.terra->hypotheses.front().motion == m.used);
+    const ulc::io::PairResult r = ulc::io::to_pair_result(c, "lidar64", "tele");
+    const auto& t = r.stages.at("terra");
+    CHECK(t.at("motion").at("ok").get<bool>());
+    CHECK(t.at("motion").at("used").get<bool>() == m.used);
+    CHECK(t.at("hypotheses").at(0).at("source").get<std::string>() == (m.used ? "motion" : "maps"));
+  }
+}
+
 TEST_CASE("automatic TERRA stays on frames for single frames and for well-overlapping frames",
           "[calibrate][map_terra]") {
   SECTION("one frame per LiDAR (a static snapshot) never builds maps") {
@@ -131,7 +172,7 @@ TEST_CASE("automatic TERRA stays on frames for single frames and for well-overla
     CHECK(!c.terra->base_map);
     CHECK(c.terra->source_reason.find("1 frame") != std::string::npos);
   }
-  SECTION("64-32 frames overlap in hundreds of cells: frames are kept, no map is built") {
+  SECTION("64-32 frames overlap in hundreds of cells: frames are kept") {
     const auto& d = calibrate_test::drive_64_32();
     const auto& a = *d.find("lidar64");
     const auto& b = *d.find("lidar32");
@@ -142,7 +183,12 @@ TEST_CASE("automatic TERRA stays on frames for single frames and for well-overla
     REQUIRE(c.success);
     CHECK(c.terra->source == ulc::TerraSource::frames);
     CHECK(*c.terra->frames_mask_count >= o.tuning.terra_source.maps_below_mask);
-    CHECK(!c.terra->base_map);
+    // The maps are built for the motion frame, which agrees with the frames: they stand.
+    REQUIRE(c.terra->motion);
+    CHECK(c.terra->motion->ok);
+    CHECK(c.terra->motion->search_off_deg < o.tuning.terra_source.maps.motion.agree_deg);
+    CHECK_FALSE(c.terra->motion->used);
+    CHECK(c.terra->hypotheses.front().motion == false);
     CHECK(error_deg(d.pairs.at(0).T_base_target.linear(), c.T_base_target.linear()) < 5.0);
   }
 }

@@ -47,11 +47,27 @@ inline Json local_map_stats(const LocalMapStats& m) {
   return j;
 }
 
+inline Json motion_report(const MotionReport& m) {
+  Json j = Json::object();
+  j["ok"] = m.ok;
+  j["reason"] = m.reason;
+  if (m.ok) j["rpy_deg"] = vector_to_json(rpy_from_rotation(m.rotation) * kDegPerRad);
+  j["travel_base_m"] = m.travel_base_m;
+  j["travel_target_m"] = m.travel_target_m;
+  j["planes_base"] = m.planes_base;
+  j["planes_target"] = m.planes_target;
+  j["planes_matched"] = m.planes_matched;
+  if (m.ok) j["search_off_deg"] = m.search_off_deg;
+  j["used"] = m.used;
+  return j;
+}
+
 }  // namespace result_detail
 
 /// stages.terra: the search's outcome and the statistics a profiler needs; "source" says
 /// whether it compared frames or local maps ("base_map" / "target_map" hold the maps'
-/// statistics when the map search ran, "frames_mask_count" the frame search's overlap).
+/// statistics when the maps were built, "frames_mask_count" the frame search's overlap,
+/// "motion" the motion frame's rotation and whether it overruled the search).
 inline Json terra_to_json(const TerraReport& t) {
   using result_detail::stage_stats;
   Json j = Json::object();
@@ -84,10 +100,11 @@ inline Json terra_to_json(const TerraReport& t) {
   }
   if (t.base_map) j["base_map"] = result_detail::local_map_stats(*t.base_map);
   if (t.target_map) j["target_map"] = result_detail::local_map_stats(*t.target_map);
+  if (t.motion) j["motion"] = result_detail::motion_report(*t.motion);
   Json hypotheses = Json::array();
   for (const TerraHypothesis& h : t.hypotheses) {
     Json e = Json::object();
-    e["source"] = to_string(h.source);
+    e["source"] = h.motion ? std::string("motion") : std::string(to_string(h.source));
     e["rpy_deg"] = vector_to_json(rpy_from_rotation(h.rotation) * result_detail::kDegPerRad);
     e["distance"] = h.distance;
     e["mask_count"] = h.mask_count;
