@@ -29,7 +29,7 @@
 //
 // Windows mode (--windows), issue 34's protocol: the eight pairs of the paper's TERRA figure,
 // 50 windows starting 1 s apart (from 1 s on) of --window seconds (default 2, the issue's cap;
-// the pipeline's default map window is 4), frames and automatic as in maps mode, and
+// the pipeline's default map window is 5), frames and automatic as in maps mode, and
 // scancontext* on each window's first frame pair.
 #include <tbb/task_arena.h>
 #include <Eigen/Core>
@@ -738,7 +738,7 @@ int main(int argc, char** argv) {
   app.add_option("--spacing", mo.spacing_s, "--maps: seconds between windows (default 3)")
       ->type_name("S");
   app.add_option("--window", mo.window_s,
-                 "--maps: seconds per window (default: the pipeline's, 4; --windows: 2)")
+                 "--maps: seconds per window (default: the pipeline's, 5; --windows: 2)")
       ->type_name("S");
   app.add_option("--decimation", mo.decimation, "--maps: keep every Nth point (default 1)")
       ->type_name("N")
