@@ -84,10 +84,6 @@ struct TerraSearches {
   bool ok() const { return kept.ok() || motion_used(); }
 };
 
-inline void notify_terra(const CalibrateOptions& o, double fraction) {
-  if (o.progress) o.progress("terra", fraction);
-}
-
 template <class FA, class FB>
 terra::SearchResult search_frames(const TerraInputs<FA, FB>& in) {
   const std::size_t i = in.options.frame_index;
@@ -115,12 +111,8 @@ template <class FA, class FB, class Maps>
 MapTerraResult search_maps(const TerraInputs<FA, FB>& in, const Maps& maps) {
   const terra::SearchParams& params = in.options.tuning.terra;
   const MapTerraOptions& options = in.options.tuning.terra_source.maps;
-  MapTerraResult r =
-      params.lattice_size < 2
-          ? search_local_maps(terra::Lattice(params.lattice_size), maps, params, options)
-          : search_local_maps(in.lattice, maps, params, options);
-  notify_terra(in.options, 1.0);
-  return r;
+  // in.lattice is empty when lattice_size < 2: the search then says so (invalid_input).
+  return search_local_maps(in.lattice, maps, params, options);
 }
 
 /// Statistics of a TERRA search, in the report's form.
@@ -229,7 +221,6 @@ TerraSearches automatic_with_maps(const TerraInputs<FA, FB>& in, const terra::Se
                                std::to_string(src.maps_below_mask) + ")");
     report.base_map = maps.a.stats;
     report.target_map = maps.b.stats;
-    notify_terra(in.options, 1.0);
     return {f, {}, maps.motion};
   }
   const std::string frames_said =
