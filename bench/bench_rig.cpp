@@ -44,11 +44,22 @@ struct Config {
   bool route = true;
   bool cycles = true;
   bool synced_clocks = false;  ///< --synced-clocks: no clock offset estimated (the rigs share one)
+  bool base_odometry = false;  ///< --base-odometry: HOTS from the base's own odometry, run once
   ulc_bench::Options bench;
 };
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// Where a target's time went, on stderr: each stage's seconds summed over the hypotheses tried
+/// (HOTS's odometry marked when it was the base's, run by an earlier target).
+void print_stage_seconds(const ulc::RigTarget& t) {
+  const ulc::StageTimings& s = t.result.timing_s;
+  const bool reused = t.result.hots && t.result.hots->odometry_reused;
+  std::cerr << "  " << t.name << ": terra " << s.terra << " s, jeep " << s.jeep << " s, odometry "
+            << s.odometry << " s" << (reused ? " (the base's, reused)" : "") << ", hots " << s.hots
+            << " s\n";
 }
 
 void bench(const Config& c) {
@@ -90,6 +101,7 @@ void bench(const Config& c) {
     ulc::RigOptions o;
     o.pair.stages = stages.stages;
     if (c.synced_clocks) o.pair.time_offset_s = 0.0;
+    if (c.base_odometry) o.pair.tuning.hots_odometry = ulc::HotsOdometry::base;
     o.route = c.route;
     o.cycles = c.cycles;
     if (!c.bench.json)
@@ -109,6 +121,7 @@ void bench(const Config& c) {
         std::cerr << "  " << t.name << ": direct " << ulc::to_string(t.direct.status) << ": "
                   << t.direct.reason << "\n  " << t.name << ": result "
                   << ulc::to_string(t.result.status) << ": " << t.result.reason << "\n";
+      if (!c.bench.json) print_stage_seconds(t);
       const auto& lidar = d.lidars[t.lidar];
       const ulc::Isometry3d truth = base.T_vehicle_lidar.inverse() * lidar.T_vehicle_lidar;
       const ulc::PoseError e = ulc::pose_error(truth, t.result.T_base_target);
@@ -197,6 +210,8 @@ int main(int argc, char** argv) {
   app.add_flag_callback(
       "--no-cycles", [&] { c.cycles = false; }, "no cycle checks");
   app.add_flag("--synced-clocks", c.synced_clocks, "the pairs' clocks agree: no offset estimated");
+  app.add_flag("--base-odometry", c.base_odometry,
+               "HOTS starts from the base's own odometry, run once for every target");
   CLI11_PARSE(app, argc, argv);
   bench(c);
   return 0;

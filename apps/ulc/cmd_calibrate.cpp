@@ -121,7 +121,8 @@ struct CalibrateArgs {
   std::vector<std::string> target_specs;
   long long frame_index = 0, frames = static_cast<long long>(jeep::JeepOptions{}.frames),
             threads = 0;
-  bool synced_clocks = false, no_route = false, no_cycles = false, quiet = false;
+  bool synced_clocks = false, no_route = false, no_cycles = false, quiet = false,
+       base_odometry = false;
   InputArgs input;
   // Set when the user gave them.
   CLI::Option *output_option = nullptr, *merged_option = nullptr, *report_option = nullptr,
@@ -201,6 +202,9 @@ void add_stage_options(CLI::App& app, CalibrateArgs& a) {
              "no offset is estimated or checked")
           ->type_name("S")
           ->excludes("--synced-clocks");
+  app.add_flag("--base-odometry", a.base_odometry,
+               "HOTS starts from the base LiDAR's own odometry, run once for every target (faster "
+               "for rigs with a 360-degree base; docs/pipeline.md, \"The odometry\")");
   app.add_flag("--no-route", a.no_route,
                "do not calibrate a failed target through another target that did calibrate");
   app.add_flag("--no-cycles", a.no_cycles,
@@ -215,6 +219,7 @@ CalibrateOptions calibrate_options(const CalibrateArgs& a) {
   c.synced_clocks = a.synced_clocks;
   if (a.has(a.time_offset_option)) c.time_offset_s = a.time_offset;
   c.frames = static_cast<std::size_t>(a.frames);
+  c.base_odometry = a.base_odometry;
   const CalibrateOptions options = calibrate_options(c);
   for (const CLI::Option* file_option : {a.output_option, a.merged_option, a.report_option})
     if (a.has(file_option)) require_output_folder(file_option->as<std::string>());

@@ -231,4 +231,22 @@ OdometryResult run_single_odometry(const Frames& frames, const std::vector<doubl
                                         progress);
 }
 
+/// A single-LiDAR odometry of base a carried to target b through the rigid mount: b's poses
+/// P_b(t_b) = C^-1 P_a(t_b) C, P_a(t_b) extrapolated from a's step nearest t_b (b's timestamps
+/// plus time_offset_s, on a's clock) with its twist; the poses and steps of a are kept. This is
+/// what the multi-LiDAR odometry does for every b frame it did not pair, done for all of them.
+inline OdometryResult with_target_poses(OdometryResult base, const std::vector<double>& times_b,
+                                        const Isometry3d& C, double time_offset_s = 0.0) {
+  if (base.steps.empty()) return base;
+  const Isometry3d C_inv = C.inverse();
+  base.poses_b.resize(times_b.size());
+  base.estimated_b.assign(times_b.size(), false);
+  for (std::size_t j = 0; j < times_b.size(); ++j) {
+    const double t = times_b[j] + time_offset_s;
+    base.poses_b[j] =
+        C_inv * detail::extrapolate(base.steps[detail::nearest_step(base.steps, t)], t) * C;
+  }
+  return base;
+}
+
 }  // namespace odometry

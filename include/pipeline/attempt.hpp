@@ -5,7 +5,8 @@
 //     judge it (HypothesisOptions::hots_judges_jeep, a moving rig, a finite extrinsic), HOTS
 //     runs from JEEP's extrinsic and decides: its success overrules JEEP, its refusal is JEEP's
 //     failure.
-//   - HOTS: the multi-LiDAR odometry (StageTuning::odometry) over ALL frames from frame_index,
+//   - HOTS: the multi-LiDAR odometry (StageTuning::odometry) over ALL frames from frame_index
+//     (StageTuning::hots_odometry base: the base's own, run by the first attempt and reused),
 //     then hots::refine on those frames and poses. An odometry that could not register some
 //     frames still feeds HOTS (its poses are predictions there); one that gives no poses ends
 //     the attempt. With fewer than StageTuning::hots_min_frames frames per LiDAR HOTS is
@@ -19,6 +20,7 @@
 #include <chrono>
 #include <cstddef>
 #include <cstdio>
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
@@ -49,6 +51,10 @@ struct AttemptInputs {
   const CalibrateOptions& options;
   hots::RefineOptions hots;  ///< StageTuning::hots with a known clock offset applied
   bool run_terra = false, run_jeep = false, run_hots = false;
+  /// The base's own odometry (StageTuning::hots_odometry base): the caller's
+  /// (CalibrateOptions::base_odometry), else filled by the first attempt that runs HOTS and
+  /// reused by every later one, since it depends on neither the target nor the extrinsic.
+  mutable std::shared_ptr<const odometry::OdometryResult> base_odometry;
   /// HOTS runs, on a moving rig: it can judge a start.
   bool can_verify() const { return run_hots && frames_left() >= options.tuning.hots_min_frames; }
   std::size_t frames_left() const { return std::min(a.size(), b.size()); }
@@ -248,17 +254,35 @@ inline std::string odometry_doubt(const HotsReport& h, const StageTuning& tuning
          "read from it, are not observed along that direction";
 }
 
+/// HOTS's starting poses from the extrinsic C (StageTuning::hots_odometry): the base's own
+/// odometry carried to the target (run once per call, or given by the caller), or the joint one.
+template <class FA, class FB>
+odometry::OdometryResult hots_odometry(const AttemptInputs<FA, FB>& in, const Isometry3d& C,
+                                       const std::string& stage) {
+  const StageTuning& tuning = in.options.tuning;
+  const odometry::ProgressFn progress = count_progress(in.options, stage);
+  if (tuning.hots_odometry == HotsOdometry::joint)
+    return odometry::run_odometry(in.a.frames, in.a.times, in.b.frames, in.b.times, C,
+                                  tuning.odometry, progress);
+  if (!in.base_odometry)
+    in.base_odometry = std::make_shared<const odometry::OdometryResult>(
+        odometry::run_single_odometry(in.a.frames, in.a.times, tuning.odometry, progress));
+  return odometry::with_target_poses(*in.base_odometry, in.b.times, C,
+                                     tuning.odometry.time_offset_s);
+}
+
 /// The odometry over every frame, then hots::refine on its poses.
 template <class FA, class FB>
 StageOutcome hots_step(const AttemptInputs<FA, FB>& in, Attempt& at) {
   const std::string odometry_stage = "odometry" + at.label, hots_stage = "hots" + at.label;
   auto t0 = std::chrono::steady_clock::now();
   notify(in.options, odometry_stage, 0.0);
-  const odometry::OdometryResult odo = odometry::run_odometry(
-      in.a.frames, in.a.times, in.b.frames, in.b.times, at.extrinsic, in.options.tuning.odometry,
-      count_progress(in.options, odometry_stage));
+  const bool reused =
+      in.options.tuning.hots_odometry == HotsOdometry::base && in.base_odometry != nullptr;
+  const odometry::OdometryResult odo = hots_odometry(in, at.extrinsic, odometry_stage);
   at.out.timing_s.odometry = seconds_since(t0);
   at.out.hots = odometry_report(odo, at.extrinsic, at.out.timing_s.odometry);
+  at.out.hots->odometry_reused = reused;
   if (at.out.hots->run == HotsRun::odometry_failed)
     return failed_after_jeep(
         at, CalibrateStatus::hots_failed,

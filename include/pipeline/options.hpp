@@ -8,6 +8,7 @@
 
 #include <cstddef>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -22,7 +23,26 @@
 #include "terra/search_params.hpp"
 #include "ulc/core/types.hpp"
 
+namespace odometry {
+struct OdometryResult;  // odometry/run_odometry.hpp
+}  // namespace odometry
+
 namespace ulc {
+
+/// Which odometry gives HOTS its starting poses (StageTuning::hots_odometry).
+enum class HotsOdometry {
+  /// The multi-LiDAR odometry (odometry/run_odometry.hpp): both LiDARs' scans in every step,
+  /// the target's through the extrinsic being tried.
+  joint,
+  /// The base LiDAR's own odometry, carried to the target through the extrinsic
+  /// (odometry::with_target_poses). It depends neither on the target nor on the extrinsic, so
+  /// one run serves every TERRA hypothesis of a call and every target of a rig (rig.hpp): 8.3 s
+  /// against the joint one's 21.8 s on the 60 s 64-32 drive, the same extrinsic. Not the
+  /// default: where the target's scans steady the poses (a Horizon base, an Avia target) HOTS
+  /// agrees with fewer cross links and its covariance grows
+  /// (docs/experiments/hots_base_odometry.md).
+  base,
+};
 
 /// Called with the running stage's name ("terra", "jeep", "odometry", "hots") and its fraction
 /// done.
@@ -35,7 +55,8 @@ struct StageTuning {
   HypothesisOptions hypotheses;     ///< TERRA's later optima tried in turn (not in the paper)
   jeep::JeepOptions jeep;           ///< K = 5 frame pairs, at most 10 rounds
   odometry::OdometryOptions odometry;  ///< the odometry over all frames that feeds HOTS
-  hots::RefineOptions hots;            ///< windows of 5, 3 layers, time synchronisation on
+  HotsOdometry hots_odometry = HotsOdometry::joint;  ///< which LiDARs that odometry registers
+  hots::RefineOptions hots;  ///< windows of 5, 3 layers, time synchronisation on
   /// Single frames or a static rig (fewer frames than this per LiDAR from frame_index): HOTS
   /// has no motion to work with, so after TERRA or JEEP it is skipped (stages.hots says so) and
   /// their extrinsic is the answer; as the only stage it fails.
@@ -68,6 +89,10 @@ struct CalibrateOptions {
   std::size_t threads = 0;
   CalibrateProgress progress;  ///< optional
   StageTuning tuning;
+  /// The base's own odometry over its frames from frame_index (ulc::base_odometry, with this
+  /// call's tuning.odometry), when the caller has already run it: a rig's targets share one
+  /// (rig.hpp). Unset: the call runs it when HOTS needs it (tuning.hots_odometry base).
+  std::shared_ptr<const odometry::OdometryResult> base_odometry;
 };
 
 }  // namespace ulc

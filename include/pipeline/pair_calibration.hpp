@@ -15,6 +15,7 @@
 #pragma once
 
 #include <cstddef>
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
@@ -29,6 +30,10 @@
 #include "ulc/core/observability_types.hpp"
 #include "ulc/core/registration_types.hpp"
 #include "ulc/core/types.hpp"
+
+namespace odometry {
+struct OdometryResult;  // odometry/run_odometry.hpp
+}  // namespace odometry
 
 namespace ulc {
 
@@ -190,6 +195,9 @@ struct HotsReport {
   /// when that step ran.
   std::optional<Observability> observability;
   double odometry_seconds = 0.0;
+  /// The base's own odometry was run before this attempt (by the caller, as a rig does for its
+  /// targets, or for an earlier TERRA hypothesis) and reused: odometry_seconds leaves it out.
+  bool odometry_reused = false;
   double seconds = 0.0;  ///< hots::refine alone
 };
 
@@ -290,6 +298,11 @@ struct PairCalibration {
   // (set whenever JEEP's or HOTS's translation is the answer), and each LiDAR's point times.
   std::optional<ClockReport> clock;
   PointTimesReport point_times_base, point_times_target;
+  /// The base's own odometry HOTS started from (StageTuning::hots_odometry base; null when HOTS
+  /// did not run, or ran on the joint odometry). It depends only on the base's frames from
+  /// frame_index and tuning.odometry: a caller with another target of the same base passes it on
+  /// as CalibrateOptions::base_odometry, as calibrate_rig does, and it is not run again.
+  std::shared_ptr<const odometry::OdometryResult> base_odometry;
 
   bool ok() const { return success; }
 };

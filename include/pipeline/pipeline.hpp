@@ -22,11 +22,13 @@
 //     the previous stage's extrinsic, or from `initial` when it is the first, which is then
 //     required (status initial_required without it).
 //   - HOTS: multi-LiDAR odometry (tuning.odometry) over ALL frames of each LiDAR from frame i
-//     on, with the extrinsic HOTS starts from, then hots::refine (tuning.hots) on those
-//     frames and poses. Its extrinsic, clock offset and covariance become the result's. An odometry
-//     that could not register some frames still feeds HOTS (its poses are predictions there;
-//     the report counts them); an odometry that gives no poses, or a HOTS that fails, ends the
-//     call with hots_failed, keeping the previous extrinsic. With fewer than
+//     on, with the extrinsic HOTS starts from (or, with tuning.hots_odometry base, the base's own
+//     odometry, run once per call or given as options.base_odometry, and the target's poses
+//     through that extrinsic; result.base_odometry hands it on), then hots::refine (tuning.hots) on
+//     those frames and poses. Its extrinsic, clock offset and covariance become the result's. An
+//     odometry that could not register some frames still feeds HOTS (its poses are predictions
+//     there; the report counts them); an odometry that gives no poses, or a HOTS that fails, ends
+//     the call with hots_failed, keeping the previous extrinsic. With fewer than
 //     tuning.hots_min_frames frames per LiDAR (single frames, as in a static rig's snapshot) HOTS
 //     is skipped after TERRA or JEEP: stages.hots has status "skipped" and the reason. A HOTS whose
 //     clock offset the drive does not pin down fails too (time_offset_untrusted: the extrinsic
@@ -114,6 +116,11 @@ InputCheck check_inputs(const FramesA& frames_a, const std::vector<double>& time
             "frame_index " + std::to_string(i) + " is past the end (base has " +
                 std::to_string(frames_a.size()) + " frames, target " +
                 std::to_string(frames_b.size()) + ")"};
+  if (options.base_odometry && options.base_odometry->poses_a.size() != frames_a.size() - i)
+    return {CalibrateStatus::invalid_input,
+            "the base odometry given has " + std::to_string(options.base_odometry->poses_a.size()) +
+                " poses, the base " + std::to_string(frames_a.size() - i) +
+                " frames from frame_index"};
   if (has_stage(options.stages, Stage::terra)) return {};
   if (!options.initial)
     return {CalibrateStatus::initial_required,
@@ -281,12 +288,14 @@ PairCalibration run_pipeline(const FA& frames_a, const std::vector<double>& time
                                  hots_options(options),
                                  has_stage(options.stages, Stage::terra),
                                  has_stage(options.stages, Stage::jeep),
-                                 has_stage(options.stages, Stage::hots)};
+                                 has_stage(options.stages, Stage::hots),
+                                 options.base_odometry};
   r.point_times_base = point_times_before(in.a.frames);
   r.point_times_target = point_times_before(in.b.frames);
   if (!in.run_terra) {
     r.T_base_target = *options.initial;
     const StageOutcome o = run_attempt(in, *options.initial, "", true, r);
+    r.base_odometry = in.base_odometry;
     finish(o.status, o.reason);
     const StageOutcome v = vouch_read(in, r);
     return finish(v.status, v.reason);
@@ -301,6 +310,7 @@ PairCalibration run_pipeline(const FA& frames_a, const std::vector<double>& time
     return terra_only(*starts, r, finish);
   }
   try_hypotheses(in, *starts, r, finish);
+  r.base_odometry = in.base_odometry;
   const StageOutcome v = vouch_read(in, r);
   return finish(v.status, v.reason);
 }

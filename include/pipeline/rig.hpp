@@ -8,7 +8,9 @@
 //     Names must be unique and not empty (the result file keys on them).
 //   - Direct: calibrate_pair(base, target, options.pair) for every target. options.pair.initial
 //     is ignored: each LiDAR carries its own guess, RigLidar::initial = T_base_lidar (needed
-//     only when options.pair.stages skip terra).
+//     only when options.pair.stages skip terra). The base's own odometry (HOTS's start) is run
+//     once, by the first target that needs it, and given to the others: each direct result is
+//     the one calibrate_pair gives alone, bit for bit.
 //   - Routing (options.route): a target whose direct attempt failed is calibrated through a
 //     LiDAR v whose direct attempt succeeded: calibrate_pair(v, target, options.pair), then
 //     T_base_target = T_base_v * T_v_target and time_offset = offset_base_v + offset_v_target
@@ -41,6 +43,7 @@
 #include <chrono>
 #include <cstddef>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -137,11 +140,13 @@ struct RigCalibration {
 
 namespace rig_detail {
 
-/// options.pair with its progress prefixed and its guess set.
+/// options.pair with its progress prefixed and its guess set; without the base's odometry
+/// (a route or a cycle has another base).
 inline CalibrateOptions pair_options(const CalibrateOptions& base, const std::string& prefix,
                                      std::optional<Isometry3d> initial) {
   CalibrateOptions o = base;
   o.initial = std::move(initial);
+  o.base_odometry = nullptr;
   if (base.progress) {
     const CalibrateProgress inner = base.progress;
     o.progress = [inner, prefix](const std::string& stage, double f) { inner(prefix + stage, f); };
@@ -188,17 +193,21 @@ std::string check_input(const std::vector<RigLidar<Frames>>& lidars, std::size_t
   return {};
 }
 
-/// Every target against the base, directly.
+/// Every target against the base, directly. The base's own odometry, run by the first target
+/// whose HOTS needed it, is handed to the next ones (CalibrateOptions::base_odometry).
 template <class Frames>
 void calibrate_directly(const std::vector<RigLidar<Frames>>& lidars, std::size_t base,
                         const RigOptions& options, RigCalibration& rig) {
+  std::shared_ptr<const odometry::OdometryResult> base_odometry = options.pair.base_odometry;
   for (std::size_t k = 0; k < lidars.size(); ++k) {
     if (k == base) continue;
     RigTarget t;
     t.lidar = k;
     t.name = lidars[k].name;
-    t.direct = calibrate(lidars[base], lidars[k],
-                         pair_options(options.pair, t.name + " ", lidars[k].initial));
+    CalibrateOptions o = pair_options(options.pair, t.name + " ", lidars[k].initial);
+    o.base_odometry = base_odometry;
+    t.direct = calibrate(lidars[base], lidars[k], o);
+    if (!base_odometry) base_odometry = t.direct.base_odometry;
     t.result = t.direct;
     rig.targets.push_back(std::move(t));
   }

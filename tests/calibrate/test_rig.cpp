@@ -3,7 +3,8 @@
 // between the targets closes; a target that the base barely sees (the blind-spot rig's
 // right Bpearl against the left one: opposite half-spaces) fails directly and is routed through
 // the front Helios that sees both, to within the same bounds; a target that nothing can
-// calibrate keeps its failure and names the routes tried; bad input comes back as a status.
+// calibrate keeps its failure and names the routes tried; bad input comes back as a status; on the
+// base's own odometry, it is run once for every target.
 #include <catch2/catch.hpp>
 #include <string>
 #include <vector>
@@ -227,4 +228,42 @@ TEST_CASE("calibrate_rig refuses bad input with a status and a reason", "[calibr
           "LiDAR 1 has no name");
   refused({{"a", &a.frames, &a.timestamps, {}}, {"a", &b.frames, &b.timestamps, {}}}, 1,
           "two LiDARs are named 'a'");
+}
+
+TEST_CASE("a rig on the base's own odometry runs it once: later targets reuse it, bit for bit",
+          "[calibrate][rig][base_odometry]") {
+  // The same VLP-32C twice under two names: the second target's calibration must be the first's
+  // to the bit, from the base odometry the first one ran, and the pair alone gives it too.
+  const auto& d = drive_64_32_hots();
+  using Frames = std::vector<ulc::PointCloud<float>>;
+  const auto& a = d.lidars[0];
+  const auto& b = d.lidars[1];
+  const std::vector<ulc::RigLidar<Frames>> lidars{{"lidar64", &a.frames, &a.timestamps, {}},
+                                                  {"lidar32", &b.frames, &b.timestamps, {}},
+                                                  {"again", &b.frames, &b.timestamps, {}}};
+  ulc::RigOptions o;
+  o.pair.time_offset_s = 0.0;
+  o.pair.tuning.hots_odometry = ulc::HotsOdometry::base;
+  o.route = false;
+  o.cycles = false;
+  const ulc::RigCalibration rig = ulc::calibrate_rig(lidars, 0, o);
+  INFO(rig.reason);
+  REQUIRE(rig.ok());
+  const ulc::PairCalibration& first = rig.targets[0].result;
+  const ulc::PairCalibration& second = rig.targets[1].result;
+  REQUIRE(first.hots);
+  REQUIRE(second.hots);
+  CHECK_FALSE(first.hots->odometry_reused);
+  CHECK(second.hots->odometry_reused);
+  REQUIRE(first.base_odometry);
+  CHECK(second.base_odometry == first.base_odometry);
+  CHECK(same_bits(first.T_base_target, second.T_base_target));
+  const ulc::PairCalibration alone =
+      ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, o.pair);
+  REQUIRE(alone.success);
+  CHECK(same_bits(alone.T_base_target, first.T_base_target));
+  const auto e = ulc::pose_error(d.pairs[0].T_base_target, first.T_base_target);
+  INFO("e_rot " << e.rotation_deg << " deg, e_trans " << e.translation_m << " m");
+  CHECK(e.rotation_deg < 1.0);
+  CHECK(e.translation_m < 0.10);
 }

@@ -1,10 +1,14 @@
 // Odometry (the pose phase run along a drive): single- and multi-LiDAR poses against the
-// simulator's trajectory, poses for unpaired frames, the same bits on 1 and 2 threads.
+// simulator's trajectory, the base's odometry carried to the target through the mount, poses
+// for unpaired frames, the same bits on 1 and 2 threads.
 #include <tbb/task_arena.h>
+#include <algorithm>
 #include <catch2/catch.hpp>
+#include <cmath>
 #include <cstring>
 #include <vector>
 
+#include "../registration/registration_test_util.hpp"
 #include "jeep_test_util.hpp"
 #include "odometry/run_odometry.hpp"
 #include "ulc/core/pose_error.hpp"
@@ -95,6 +99,50 @@ TEST_CASE("multi-LiDAR odometry gives both LiDARs' poses in their own map frames
     const Isometry3d Pa_tb = s.pose_a * ulc::se3_exp(Vec6d((s.t_b - s.t_a) * s.twist));
     CHECK(s.pose_b.isApprox(Isometry3d(C.inverse() * Pa_tb * C), 1e-9));
   }
+}
+
+TEST_CASE("the base's own odometry carried through the mount gives the target's poses",
+          "[jeep][odometry]") {
+  const auto& d = odometry_drive();
+  const auto& a = d.lidars[0];
+  const auto& b = d.lidars[1];
+  const Isometry3d C = d.pairs[0].T_base_target;
+  const auto single = odometry::run_single_odometry(a.frames, a.timestamps);
+  REQUIRE(single.ok());
+  const auto r = odometry::with_target_poses(single, b.timestamps, C);
+  REQUIRE(r.ok());
+  REQUIRE(r.poses_b.size() == b.frames.size());
+  for (std::size_t i = 0; i < a.frames.size(); ++i)
+    CHECK(reg_test::same_bits(r.poses_a[i], single.poses_a[i]));  // a's own poses are kept
+  // b's poses against the truth, in map b (b's frame at a's first instant), within the joint
+  // odometry's bounds above.
+  const Isometry3d origin_a = lidar_pose(d, 0, a.timestamps[0]);
+  const auto eb =
+      worst_relative_error(r.poses_b, truth_of(d, 1, b.timestamps), Isometry3d(origin_a * C));
+  INFO("b: " << eb.rotation_deg << " deg, " << eb.translation_m << " m");
+  CHECK(eb.rotation_deg < 0.15);
+  CHECK(eb.translation_m < 0.03);
+  // The rigid mount at b's instants: P_b = C^-1 P_a(t_b) C, a's pose carried by its twist.
+  for (std::size_t j = 0; j < b.frames.size(); ++j) {
+    const double t = b.timestamps[j];
+    const auto& s = *std::min_element(
+        single.steps.begin(), single.steps.end(),
+        [t](const auto& x, const auto& y) { return std::abs(x.t_a - t) < std::abs(y.t_a - t); });
+    const Isometry3d Pa_tb = s.pose_a * ulc::se3_exp(Vec6d((t - s.t_a) * s.twist));
+    CHECK(r.poses_b[j].isApprox(Isometry3d(C.inverse() * Pa_tb * C), 1e-9));
+  }
+  // A clock offset moves b's instants on a's clock: the pose of t_b + offset.
+  const auto shifted = odometry::with_target_poses(single, b.timestamps, C, 0.05);
+  const auto later = odometry::with_target_poses(
+      single,
+      [&] {
+        auto t = b.timestamps;
+        for (double& x : t) x += 0.05;
+        return t;
+      }(),
+      C);
+  for (std::size_t j = 0; j < b.frames.size(); ++j)
+    CHECK(reg_test::same_bits(shifted.poses_b[j], later.poses_b[j]));
 }
 
 TEST_CASE("odometry poses unpaired frames by extrapolating the nearest pair", "[jeep][odometry]") {

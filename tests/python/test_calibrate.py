@@ -155,3 +155,22 @@ def test_clouds_with_a_points_attribute_are_read_as_arrays(frames):
     from_clouds = ulc.calibrate(Cloud(a[:, :3]), Cloud(b[:, :3]), stages="terra")
     assert from_arrays.success
     np.testing.assert_array_equal(from_clouds.T_base_target, from_arrays.T_base_target)
+
+
+def test_base_odometry_is_the_command_lines(drive, tmp_path):
+    """base_odometry=True is --base-odometry: HOTS from the base's own odometry, same result file."""
+    guess = str(tmp_path / "guess.json")
+    ulc.calibrate(lidar(drive, "lidar64"), lidar(drive, "lidar32"), stages="terra,jeep",
+                  synced_clocks=True).write(guess)
+    out = str(tmp_path / "result.json")
+    code, stdout, stderr = run_ulc("calibrate", "--quiet", "--base", lidar(drive, "lidar64"),
+                                   "--target", lidar(drive, "lidar32"), "--synced-clocks",
+                                   "--stages", "hots", "--initial", guess, "--base-odometry",
+                                   "--output", out)
+    assert os.path.exists(out), stdout + stderr
+    ours = ulc.calibrate(lidar(drive, "lidar64"), lidar(drive, "lidar32"), stages="hots",
+                         initial=guess, synced_clocks=True, base_odometry=True)
+    with open(out) as f:
+        cli = json.load(f)
+    assert without_timings(json.loads(ours.to_json())) == without_timings(cli)
+    assert cli["results"][0]["stages"]["hots"]["odometry_reused"] is False

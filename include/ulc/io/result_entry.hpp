@@ -233,6 +233,7 @@ inline Json hots_to_json(const HotsReport& h) {
   phases["sequence"] = s.sequence_seconds;
   j["phase_seconds"] = std::move(phases);
   j["odometry_seconds"] = h.odometry_seconds;
+  j["odometry_reused"] = h.odometry_reused;
   j["seconds"] = h.seconds;
   return j;
 }
