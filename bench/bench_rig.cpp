@@ -4,10 +4,13 @@
 //
 //   bench_rig [--scenarios ring-5x16,pitched-90,side-bpearl] [--seconds 10]
 //             [--stages terra,jeep,hots] [--decimation 1] [--seed 1] [--threads 2]
-//             [--no-route] [--no-cycles] [--synced-clocks] [--json]
+//             [--no-route] [--no-cycles] [--synced-clocks] [--base-odometry] [--no-motion]
+//             [--json]
 // --synced-clocks: the pairs are told their clocks agree (the simulated rigs' do), so HOTS
 // neither estimates nor checks an offset; without it, a drive too short to pin the offset down
-// fails with time_offset_untrusted.
+// fails with time_offset_untrusted. --base-odometry: HOTS starts from the base's own odometry,
+// run once for every target. --no-motion: TERRA's motion frame off (map_terra_options.hpp).
+// On stderr, per target: each stage's seconds and the TERRA hypotheses tried.
 //
 // Per target: e_rot (deg) and e_trans (cm) against the simulator's mounts, the calibration's
 // status, the route, the clock offset error when HOTS ran, the cross links of the kept result
@@ -45,6 +48,7 @@ struct Config {
   bool cycles = true;
   bool synced_clocks = false;  ///< --synced-clocks: no clock offset estimated (the rigs share one)
   bool base_odometry = false;  ///< --base-odometry: HOTS from the base's own odometry, run once
+  bool motion = true;          ///< --no-motion: TERRA's motion frame off
   ulc_bench::Options bench;
 };
 
@@ -52,14 +56,16 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-/// Where a target's time went, on stderr: each stage's seconds summed over the hypotheses tried
-/// (HOTS's odometry marked when it was the base's, run by an earlier target).
+/// Where a target's time went, on stderr: each stage's seconds summed over the TERRA hypotheses
+/// tried (HOTS's odometry marked when it was the base's, run by an earlier target), and how many
+/// hypotheses were tried.
 void print_stage_seconds(const ulc::RigTarget& t) {
   const ulc::StageTimings& s = t.result.timing_s;
   const bool reused = t.result.hots && t.result.hots->odometry_reused;
+  const std::size_t tried = t.result.terra ? t.result.terra->hypotheses.size() : 0;
   std::cerr << "  " << t.name << ": terra " << s.terra << " s, jeep " << s.jeep << " s, odometry "
             << s.odometry << " s" << (reused ? " (the base's, reused)" : "") << ", hots " << s.hots
-            << " s\n";
+            << " s; TERRA hypotheses tried " << tried << "\n";
 }
 
 void bench(const Config& c) {
@@ -102,6 +108,7 @@ void bench(const Config& c) {
     o.pair.stages = stages.stages;
     if (c.synced_clocks) o.pair.time_offset_s = 0.0;
     if (c.base_odometry) o.pair.tuning.hots_odometry = ulc::HotsOdometry::base;
+    o.pair.tuning.terra_source.maps.motion.enabled = c.motion;
     o.route = c.route;
     o.cycles = c.cycles;
     if (!c.bench.json)
@@ -212,6 +219,8 @@ int main(int argc, char** argv) {
   app.add_flag("--synced-clocks", c.synced_clocks, "the pairs' clocks agree: no offset estimated");
   app.add_flag("--base-odometry", c.base_odometry,
                "HOTS starts from the base's own odometry, run once for every target");
+  app.add_flag_callback(
+      "--no-motion", [&] { c.motion = false; }, "TERRA's motion frame off");
   CLI11_PARSE(app, argc, argv);
   bench(c);
   return 0;
