@@ -202,9 +202,11 @@ void add_stage_options(CLI::App& app, CalibrateArgs& a) {
              "no offset is estimated or checked")
           ->type_name("S")
           ->excludes("--synced-clocks");
-  app.add_flag("--base-odometry", a.base_odometry,
-               "HOTS starts from the base LiDAR's own odometry, run once for every target (faster "
-               "for rigs with a 360-degree base; docs/pipeline.md, \"The odometry\")");
+  app.add_flag(
+      "--base-odometry", a.base_odometry,
+      "HOTS starts from the base LiDAR's own odometry; it and HOTS's work on the base are done "
+      "once for every target (faster "
+      "for rigs with a 360-degree base; docs/pipeline.md, \"The odometry\")");
   app.add_flag("--no-route", a.no_route,
                "do not calibrate a failed target through another target that did calibrate");
   app.add_flag("--no-cycles", a.no_cycles,

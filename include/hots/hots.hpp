@@ -47,6 +47,10 @@
 //     or singular: the spread of the per-pair extrinsics, or without synchronisation the graph's
 //     marginal covariance of C.
 //   - refined poses are returned in the input map frames (b's through T_mapa_mapb).
+//   - a's preparation (PreparedLidar: its deskewed, thinned frames, sweeps, hierarchy, bridges and
+//     the hierarchy's poses) depends only on a's frames, poses and the options. It can be handed
+//     from one call to the next (prepared_a), and is used when it was built from the same poses
+//     bit for bit: a rig's targets on the base's own odometry share it (pipeline/rig.hpp).
 //   - With time synchronisation on, the whole-sequence step checks that the drive pins the
 //     clock offset down (sequence_extrinsic.hpp, check_time_offset); when it does not, the
 //     status is time_offset_untrusted and reason says why: the extrinsic absorbs v * (the
@@ -68,6 +72,7 @@
 //     same for any number of threads.
 #pragma once
 
+#include <memory>
 #include <utility>
 
 #include "hots/refine_statistics.hpp"
@@ -87,9 +92,14 @@ using RefineProgress = ulc::StepProgress;
 /// calling thread after each phase and within them: every few windows of the hierarchies and
 /// registrations of the cross links (ulc/core/batched_for.hpp), after each sub-step of the
 /// whole-sequence step; it may throw to stop refine there.
+/// prepared_a (optional): a preparation of a (PreparedLidar) from an earlier call with the same
+/// frames of a and options; it is used when it was built from a.poses bit for bit, else a is
+/// prepared afresh. On return it holds the preparation used (once a was prepared), for the next
+/// call: a base LiDAR's part of refine is then done once for several targets.
 template <typename S = float, class SeqA, class SeqB>
 RefineResult refine(const SeqA& a, const SeqB& b, const Isometry3d& extrinsic,
-                    const RefineOptions& options = {}, const RefineProgress& progress = {}) {
+                    const RefineOptions& options = {}, const RefineProgress& progress = {},
+                    std::shared_ptr<PreparedLidar<S>>* prepared_a = nullptr) {
   namespace d = hots_detail;
   RefineResult result;
   result.extrinsic = extrinsic;
@@ -104,7 +114,8 @@ RefineResult refine(const SeqA& a, const SeqB& b, const Isometry3d& extrinsic,
   if (const char* why = d::input_problem(a, b, extrinsic, options))
     return fail(RefineStatus::invalid_input, why);
   RefineStatistics& st = result.statistics;
-  d::RefineState<S> s(a, b);
+  const bool reusable = prepared_a && *prepared_a && built_from(**prepared_a, a.poses);
+  d::RefineState<S> s(a, b, reusable ? *prepared_a : nullptr);
   s.start = extrinsic;
   s.mapa_mapb = d::map_b_in_map_a(s.a, s.b, extrinsic, options.time_offset_s);
   auto done = [&progress](double share) {
@@ -116,6 +127,7 @@ RefineResult refine(const SeqA& a, const SeqB& b, const Isometry3d& extrinsic,
   d::prepare_lidars(a, b, s, options, st, within(0.0, 0.06));
   done(0.06);
   d::build_hierarchies(s, options, st, within(0.06, 0.41));
+  if (prepared_a) *prepared_a = s.a.prepared;
   done(0.41);
   const bool linked = d::link_lidars(s, options.time_offset_s, options, st, within(0.41, 0.68));
   done(0.68);

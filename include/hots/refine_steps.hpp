@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstddef>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -27,6 +28,30 @@
 #include "ulc/core/voxel_downsample.hpp"
 
 namespace hots {
+
+/// What refine builds for one LiDAR from its own frames, timestamps and odometry alone: the frames
+/// deskewed and thinned, their sweeps, the hierarchy and its bridges, and the poses the hierarchy
+/// gave. Nothing after build_hierarchies changes it, so base LiDAR a's can serve another refine
+/// call with the same frames, odometry poses and options (refine's prepared_a).
+template <typename S>
+struct PreparedLidar {
+  std::vector<Isometry3d> built_from;  ///< the odometry poses it was built from
+  std::vector<Isometry3d> world;       ///< the odometry's, then the hierarchy's (map a)
+  std::vector<std::vector<ulc::Vec3<S>>> frames;
+  std::vector<SweepParts<S>> sweeps;  ///< when hierarchy.sweep_parts > 1 (views into frames)
+  HierarchyResult<S> hierarchy;
+  BoundaryBridges bridges;
+};
+
+/// `prepared` was built from exactly these odometry poses (bit for bit).
+template <typename S>
+bool built_from(const PreparedLidar<S>& prepared, const std::vector<Isometry3d>& poses) {
+  if (prepared.built_from.size() != poses.size()) return false;
+  for (std::size_t i = 0; i < poses.size(); ++i)
+    if (!(prepared.built_from[i].matrix().array() == poses[i].matrix().array()).all()) return false;
+  return true;
+}
+
 namespace hots_detail {
 
 /// The trust rule on the cross links (see the conventions); no attempt: nothing to judge.
@@ -182,20 +207,32 @@ const char* input_problem(const SeqA& a, const SeqB& b, const Isometry3d& extrin
   return nullptr;
 }
 
-/// One LiDAR as refine works on it: its timestamps and odometry, its frames deskewed and thinned,
-/// its hierarchy, and its poses in the common world (map a).
+/// One LiDAR as refine works on it: its timestamps and odometry, what was prepared from them
+/// (held by `prepared`, shared when it was reused), the registered top-layer boundaries and its
+/// place in the graph.
 template <typename S>
 struct RefineLidar {
-  RefineLidar(const std::vector<double>& t, const std::vector<Isometry3d>& poses)
-      : times(t), odometry(poses) {}
+  RefineLidar(const std::vector<double>& t, const std::vector<Isometry3d>& poses,
+              std::shared_ptr<PreparedLidar<S>> p)
+      : times(t),
+        odometry(poses),
+        reused(p != nullptr),
+        prepared(p ? std::move(p) : std::make_shared<PreparedLidar<S>>()),
+        world(prepared->world),
+        frames(prepared->frames),
+        sweeps(prepared->sweeps),
+        hierarchy(prepared->hierarchy),
+        bridges(prepared->bridges) {}
 
   const std::vector<double>& times;
   const std::vector<Isometry3d>& odometry;  ///< the input poses, in the LiDAR's own map
-  std::vector<Isometry3d> world;
-  std::vector<std::vector<ulc::Vec3<S>>> frames;
-  std::vector<SweepParts<S>> sweeps;  ///< when hierarchy.sweep_parts > 1
-  HierarchyResult<S> hierarchy;
-  BoundaryBridges bridges;
+  const bool reused;                        ///< prepared came built: nothing to prepare or build
+  const std::shared_ptr<PreparedLidar<S>> prepared;
+  std::vector<Isometry3d>& world;
+  std::vector<std::vector<ulc::Vec3<S>>>& frames;
+  std::vector<SweepParts<S>>& sweeps;
+  HierarchyResult<S>& hierarchy;
+  BoundaryBridges& bridges;
   std::vector<std::optional<CrossLink>> boundaries;  ///< top-layer boundaries registered
   std::size_t first_var = 0;                         ///< its first pose in the graph
 };
@@ -203,9 +240,10 @@ struct RefineLidar {
 /// Everything one refine call builds, step after step.
 template <typename S>
 struct RefineState {
+  /// prepared_a: a's preparation to reuse (built from seq_a's poses), or null.
   template <class SeqA, class SeqB>
-  RefineState(const SeqA& seq_a, const SeqB& seq_b)
-      : a(seq_a.times, seq_a.poses), b(seq_b.times, seq_b.poses) {}
+  RefineState(const SeqA& seq_a, const SeqB& seq_b, std::shared_ptr<PreparedLidar<S>> prepared_a)
+      : a(seq_a.times, seq_a.poses, std::move(prepared_a)), b(seq_b.times, seq_b.poses, nullptr) {}
 
   RefineLidar<S> a, b;
   Isometry3d start = Isometry3d::Identity();  ///< the extrinsic refine started from
@@ -240,12 +278,15 @@ void prepare_lidars(const SeqA& seq_a, const SeqB& seq_b, RefineState<S>& s,
                     const RefineOptions& options, RefineStatistics& st,
                     const ulc::StepProgress& progress) {
   const int parts = options.hierarchy.sweep_parts;
-  const double share_a = share_of_a(s.a.times.size(), s.b.times.size());
-  s.a.world = s.a.odometry;
+  const double share_a = s.a.reused ? 0.0 : share_of_a(s.a.times.size(), s.b.times.size());
   for (const auto& T : s.b.odometry) s.b.world.push_back(s.mapa_mapb * T);
-  s.a.frames = prepare_frames<S>(seq_a.frames, s.a.times, s.a.odometry, options.frame_voxel,
-                                 parts > 1 ? &s.a.sweeps : nullptr, parts,
-                                 ulc::progress_within(progress, 0.0, share_a));
+  if (!s.a.reused) {
+    s.a.prepared->built_from = s.a.odometry;
+    s.a.world = s.a.odometry;
+    s.a.frames = prepare_frames<S>(seq_a.frames, s.a.times, s.a.odometry, options.frame_voxel,
+                                   parts > 1 ? &s.a.sweeps : nullptr, parts,
+                                   ulc::progress_within(progress, 0.0, share_a));
+  }
   s.b.frames = prepare_frames<S>(seq_b.frames, s.b.times, s.b.odometry, options.frame_voxel,
                                  parts > 1 ? &s.b.sweeps : nullptr, parts,
                                  ulc::progress_within(progress, share_a, 1.0));
@@ -258,24 +299,23 @@ void prepare_lidars(const SeqA& seq_a, const SeqB& seq_b, RefineState<S>& s,
 template <typename S>
 void build_hierarchies(RefineState<S>& s, const RefineOptions& options, RefineStatistics& st,
                        const ulc::StepProgress& progress) {
-  const double share_a = share_of_a(s.a.frames.size(), s.b.frames.size());
+  const double share_a = s.a.reused ? 0.0 : share_of_a(s.a.frames.size(), s.b.frames.size());
   for (RefineLidar<S>* l : {&s.a, &s.b}) {
+    if (l->reused) continue;
     const bool parts = options.hierarchy.sweep_parts > 1;
     const bool is_a = l == &s.a;
     l->hierarchy =
         build_hierarchy(l->frames, l->world, options.hierarchy, parts ? &l->sweeps : nullptr,
                         ulc::progress_within(progress, is_a ? 0.0 : share_a, is_a ? share_a : 1.0));
-  }
-  for (RefineLidar<S>* l : {&s.a, &s.b})
     if (options.boundary_bridges)
       l->bridges = boundary_bridges(l->hierarchy, l->frames, options.hierarchy);
+    l->world = l->hierarchy.poses;
+  }
   st.hierarchy_seconds = lap(s.clock);
   st.windows =
       s.a.hierarchy.windows + s.b.hierarchy.windows + s.a.bridges.windows + s.b.bridges.windows;
   st.failed_windows = s.a.hierarchy.failed_windows + s.b.hierarchy.failed_windows;
   st.planes = s.a.hierarchy.planes + s.b.hierarchy.planes + s.a.bridges.planes + s.b.bridges.planes;
-  s.a.world = s.a.hierarchy.poses;
-  s.b.world = s.b.hierarchy.poses;
 }
 
 /// The cross links between the LiDARs (cross_links.hpp); false when too few agree with the

@@ -51,10 +51,10 @@ struct AttemptInputs {
   const CalibrateOptions& options;
   hots::RefineOptions hots;  ///< StageTuning::hots with a known clock offset applied
   bool run_terra = false, run_jeep = false, run_hots = false;
-  /// The base's own odometry (StageTuning::hots_odometry base): the caller's
-  /// (CalibrateOptions::base_odometry), else filled by the first attempt that runs HOTS and
-  /// reused by every later one, since it depends on neither the target nor the extrinsic.
-  mutable std::shared_ptr<const odometry::OdometryResult> base_odometry;
+  /// The base's own work (StageTuning::hots_odometry base): the caller's
+  /// (CalibrateOptions::base_work), else filled by the first attempt that runs HOTS and reused
+  /// by every later one, since it depends on neither the target nor the extrinsic.
+  mutable BaseWork base;
   /// HOTS runs, on a moving rig: it can judge a start.
   bool can_verify() const { return run_hots && frames_left() >= options.tuning.hots_min_frames; }
   std::size_t frames_left() const { return std::min(a.size(), b.size()); }
@@ -264,10 +264,10 @@ odometry::OdometryResult hots_odometry(const AttemptInputs<FA, FB>& in, const Is
   if (tuning.hots_odometry == HotsOdometry::joint)
     return odometry::run_odometry(in.a.frames, in.a.times, in.b.frames, in.b.times, C,
                                   tuning.odometry, progress);
-  if (!in.base_odometry)
-    in.base_odometry = std::make_shared<const odometry::OdometryResult>(
+  if (!in.base.odometry)
+    in.base.odometry = std::make_shared<const odometry::OdometryResult>(
         odometry::run_single_odometry(in.a.frames, in.a.times, tuning.odometry, progress));
-  return odometry::with_target_poses(*in.base_odometry, in.b.times, C,
+  return odometry::with_target_poses(*in.base.odometry, in.b.times, C,
                                      tuning.odometry.time_offset_s);
 }
 
@@ -278,7 +278,7 @@ StageOutcome hots_step(const AttemptInputs<FA, FB>& in, Attempt& at) {
   auto t0 = std::chrono::steady_clock::now();
   notify(in.options, odometry_stage, 0.0);
   const bool reused =
-      in.options.tuning.hots_odometry == HotsOdometry::base && in.base_odometry != nullptr;
+      in.options.tuning.hots_odometry == HotsOdometry::base && in.base.odometry != nullptr;
   const odometry::OdometryResult odo = hots_odometry(in, at.extrinsic, odometry_stage);
   at.out.timing_s.odometry = seconds_since(t0);
   at.out.hots = odometry_report(odo, at.extrinsic, at.out.timing_s.odometry);
@@ -295,10 +295,14 @@ StageOutcome hots_step(const AttemptInputs<FA, FB>& in, Attempt& at) {
   a.poses = odo.poses_a;
   b.poses = odo.poses_b;
   t0 = std::chrono::steady_clock::now();
+  const bool base_only = in.options.tuning.hots_odometry == HotsOdometry::base;
+  const bool prepared = base_only && in.base.hots != nullptr;
   const hots::RefineResult h = hots::refine(
-      a, b, at.extrinsic, in.hots, [&](double share) { notify(in.options, hots_stage, share); });
+      a, b, at.extrinsic, in.hots, [&](double share) { notify(in.options, hots_stage, share); },
+      base_only ? &in.base.hots : nullptr);
   at.out.timing_s.hots = seconds_since(t0);
   add_refine(*at.out.hots, h, at.out.timing_s.hots);
+  at.out.hots->base_prepared_reused = prepared;
   at.out.hots->time_offset_s += at.out.time_offset_s;  // back to b's own clock
   if (!h.ok())
     return failed_after_jeep(

@@ -26,6 +26,10 @@
 namespace odometry {
 struct OdometryResult;  // odometry/run_odometry.hpp
 }  // namespace odometry
+namespace hots {
+template <typename S>
+struct PreparedLidar;  // hots/refine_steps.hpp
+}  // namespace hots
 
 namespace ulc {
 
@@ -42,6 +46,17 @@ enum class HotsOdometry {
   /// agrees with fewer cross links and its covariance grows
   /// (docs/experiments/hots_base_odometry.md).
   base,
+};
+
+/// What a call did for the base LiDAR alone (StageTuning::hots_odometry base), for another call
+/// on the same base frames from the same frame_index with the same tuning: a rig's targets share
+/// it (rig.hpp). Each part is run when first needed and then reused.
+struct BaseWork {
+  /// The base's own odometry over its frames from frame_index (tuning.odometry).
+  std::shared_ptr<const odometry::OdometryResult> odometry;
+  /// HOTS's preparation of the base's frames on those poses: deskewed and thinned frames, the
+  /// hierarchy and its bridges (hots::refine's prepared_a; used only when built from them).
+  std::shared_ptr<hots::PreparedLidar<float>> hots;
 };
 
 /// Called with the running stage's name ("terra", "jeep", "odometry", "hots") and its fraction
@@ -89,10 +104,10 @@ struct CalibrateOptions {
   std::size_t threads = 0;
   CalibrateProgress progress;  ///< optional
   StageTuning tuning;
-  /// The base's own odometry over its frames from frame_index (ulc::base_odometry, with this
-  /// call's tuning.odometry), when the caller has already run it: a rig's targets share one
-  /// (rig.hpp). Unset: the call runs it when HOTS needs it (tuning.hots_odometry base).
-  std::shared_ptr<const odometry::OdometryResult> base_odometry;
+  /// The base's work from an earlier call on the same base (PairCalibration::base_work), with
+  /// tuning.hots_odometry base: a rig's targets share it (rig.hpp). Empty: the call does it when
+  /// HOTS needs it.
+  BaseWork base_work;
 };
 
 }  // namespace ulc

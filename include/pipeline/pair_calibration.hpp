@@ -25,15 +25,12 @@
 #include "jeep/status.hpp"
 #include "odometry/status.hpp"
 #include "pipeline/map_terra_options.hpp"
+#include "pipeline/options.hpp"
 #include "pipeline/stages.hpp"
 #include "terra/search_params.hpp"
 #include "ulc/core/observability_types.hpp"
 #include "ulc/core/registration_types.hpp"
 #include "ulc/core/types.hpp"
-
-namespace odometry {
-struct OdometryResult;  // odometry/run_odometry.hpp
-}  // namespace odometry
 
 namespace ulc {
 
@@ -198,6 +195,9 @@ struct HotsReport {
   /// The base's own odometry was run before this attempt (by the caller, as a rig does for its
   /// targets, or for an earlier TERRA hypothesis) and reused: odometry_seconds leaves it out.
   bool odometry_reused = false;
+  /// HOTS's preparation of the base's frames (deskewed, thinned, its hierarchy and bridges) came
+  /// from an earlier hypothesis or target on the same poses: its time is not in seconds.
+  bool base_prepared_reused = false;
   double seconds = 0.0;  ///< hots::refine alone
 };
 
@@ -298,11 +298,11 @@ struct PairCalibration {
   // (set whenever JEEP's or HOTS's translation is the answer), and each LiDAR's point times.
   std::optional<ClockReport> clock;
   PointTimesReport point_times_base, point_times_target;
-  /// The base's own odometry HOTS started from (StageTuning::hots_odometry base; null when HOTS
-  /// did not run, or ran on the joint odometry). It depends only on the base's frames from
-  /// frame_index and tuning.odometry: a caller with another target of the same base passes it on
-  /// as CalibrateOptions::base_odometry, as calibrate_rig does, and it is not run again.
-  std::shared_ptr<const odometry::OdometryResult> base_odometry;
+  /// What this call did for the base alone (StageTuning::hots_odometry base; empty otherwise, or
+  /// when HOTS did not run): its odometry and HOTS's preparation of its frames. A caller with
+  /// another target of the same base passes it on as CalibrateOptions::base_work, as
+  /// calibrate_rig does, and it is not done again.
+  BaseWork base_work;
 
   bool ok() const { return success; }
 };

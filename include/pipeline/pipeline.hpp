@@ -23,8 +23,8 @@
 //     required (status initial_required without it).
 //   - HOTS: multi-LiDAR odometry (tuning.odometry) over ALL frames of each LiDAR from frame i
 //     on, with the extrinsic HOTS starts from (or, with tuning.hots_odometry base, the base's own
-//     odometry, run once per call or given as options.base_odometry, and the target's poses
-//     through that extrinsic; result.base_odometry hands it on), then hots::refine (tuning.hots) on
+//     odometry, run once per call or given as options.base_work, and the target's poses
+//     through that extrinsic; result.base_work hands it on), then hots::refine (tuning.hots) on
 //     those frames and poses. Its extrinsic, clock offset and covariance become the result's. An
 //     odometry that could not register some frames still feeds HOTS (its poses are predictions
 //     there; the report counts them); an odometry that gives no poses, or a HOTS that fails, ends
@@ -116,9 +116,10 @@ InputCheck check_inputs(const FramesA& frames_a, const std::vector<double>& time
             "frame_index " + std::to_string(i) + " is past the end (base has " +
                 std::to_string(frames_a.size()) + " frames, target " +
                 std::to_string(frames_b.size()) + ")"};
-  if (options.base_odometry && options.base_odometry->poses_a.size() != frames_a.size() - i)
+  const auto& base_odometry = options.base_work.odometry;
+  if (base_odometry && base_odometry->poses_a.size() != frames_a.size() - i)
     return {CalibrateStatus::invalid_input,
-            "the base odometry given has " + std::to_string(options.base_odometry->poses_a.size()) +
+            "the base odometry given has " + std::to_string(base_odometry->poses_a.size()) +
                 " poses, the base " + std::to_string(frames_a.size() - i) +
                 " frames from frame_index"};
   if (has_stage(options.stages, Stage::terra)) return {};
@@ -289,13 +290,13 @@ PairCalibration run_pipeline(const FA& frames_a, const std::vector<double>& time
                                  has_stage(options.stages, Stage::terra),
                                  has_stage(options.stages, Stage::jeep),
                                  has_stage(options.stages, Stage::hots),
-                                 options.base_odometry};
+                                 options.base_work};
   r.point_times_base = point_times_before(in.a.frames);
   r.point_times_target = point_times_before(in.b.frames);
   if (!in.run_terra) {
     r.T_base_target = *options.initial;
     const StageOutcome o = run_attempt(in, *options.initial, "", true, r);
-    r.base_odometry = in.base_odometry;
+    r.base_work = in.base;
     finish(o.status, o.reason);
     const StageOutcome v = vouch_read(in, r);
     return finish(v.status, v.reason);
@@ -310,7 +311,7 @@ PairCalibration run_pipeline(const FA& frames_a, const std::vector<double>& time
     return terra_only(*starts, r, finish);
   }
   try_hypotheses(in, *starts, r, finish);
-  r.base_odometry = in.base_odometry;
+  r.base_work = in.base;
   const StageOutcome v = vouch_read(in, r);
   return finish(v.status, v.reason);
 }

@@ -8,9 +8,10 @@
 //     Names must be unique and not empty (the result file keys on them).
 //   - Direct: calibrate_pair(base, target, options.pair) for every target. options.pair.initial
 //     is ignored: each LiDAR carries its own guess, RigLidar::initial = T_base_lidar (needed
-//     only when options.pair.stages skip terra). The base's own odometry (HOTS's start) is run
-//     once, by the first target that needs it, and given to the others: each direct result is
-//     the one calibrate_pair gives alone, bit for bit.
+//     only when options.pair.stages skip terra). With tuning.hots_odometry base, the base's own
+//     odometry and HOTS's preparation of its frames are done once, by the first target that
+//     needs them, and given to the others: each direct result is the one calibrate_pair gives
+//     alone, bit for bit.
 //   - Routing (options.route): a target whose direct attempt failed is calibrated through a
 //     LiDAR v whose direct attempt succeeded: calibrate_pair(v, target, options.pair), then
 //     T_base_target = T_base_v * T_v_target and time_offset = offset_base_v + offset_v_target
@@ -146,7 +147,7 @@ inline CalibrateOptions pair_options(const CalibrateOptions& base, const std::st
                                      std::optional<Isometry3d> initial) {
   CalibrateOptions o = base;
   o.initial = std::move(initial);
-  o.base_odometry = nullptr;
+  o.base_work = {};
   if (base.progress) {
     const CalibrateProgress inner = base.progress;
     o.progress = [inner, prefix](const std::string& stage, double f) { inner(prefix + stage, f); };
@@ -194,23 +195,27 @@ std::string check_input(const std::vector<RigLidar<Frames>>& lidars, std::size_t
 }
 
 /// Every target against the base, directly. The base's own odometry, run by the first target
-/// whose HOTS needed it, is handed to the next ones (CalibrateOptions::base_odometry).
+/// whose HOTS needed it, and HOTS's preparation of its frames are handed to the next ones
+/// (CalibrateOptions::base_work).
 template <class Frames>
 void calibrate_directly(const std::vector<RigLidar<Frames>>& lidars, std::size_t base,
                         const RigOptions& options, RigCalibration& rig) {
-  std::shared_ptr<const odometry::OdometryResult> base_odometry = options.pair.base_odometry;
+  BaseWork shared = options.pair.base_work;
   for (std::size_t k = 0; k < lidars.size(); ++k) {
     if (k == base) continue;
     RigTarget t;
     t.lidar = k;
     t.name = lidars[k].name;
     CalibrateOptions o = pair_options(options.pair, t.name + " ", lidars[k].initial);
-    o.base_odometry = base_odometry;
+    o.base_work = shared;
     t.direct = calibrate(lidars[base], lidars[k], o);
-    if (!base_odometry) base_odometry = t.direct.base_odometry;
+    if (!shared.odometry) shared.odometry = t.direct.base_work.odometry;
+    if (!shared.hots) shared.hots = t.direct.base_work.hots;
     t.result = t.direct;
     rig.targets.push_back(std::move(t));
   }
+  // The base's prepared frames are large (hundreds of MB on a long drive): not kept in results.
+  for (RigTarget& t : rig.targets) t.direct.base_work.hots = t.result.base_work.hots = nullptr;
 }
 
 /// The targets calibrated directly, best first (JEEP's overlap, then the name).

@@ -294,8 +294,9 @@ TEST_CASE("ulc calibrate --stages hots is accepted and runs odometry and HOTS ov
   CHECK(synced_hots.at("time_offset_checked").get<bool>() == false);
   CHECK(synced_hots.at("time_sync_pairs").get<double>() == 0);  // the synchronisation never ran
 
-  // --base-odometry: the base's own odometry, run for the first target and reused by the second
-  // (the same LiDAR under another name), whose answer is then the first's.
+  // --base-odometry: the base's own odometry and HOTS's preparation of its frames, done for the
+  // first target and reused by the second (the same LiDAR under another name), whose answer is
+  // then the first's.
   const auto shared = run_command(
       kUlc + " calibrate --quiet --synced-clocks --base-odometry" + d.pair_args() + " --target " +
       quote((d.dir / "lidar32").string() + "=again") + " --no-cycles --stages hots --initial " +
@@ -306,6 +307,7 @@ TEST_CASE("ulc calibrate --stages hots is accepted and runs odometry and HOTS ov
   CHECK(rb[1].target == "again");
   CHECK(rb[0].stages.at("hots").at("odometry_reused").get<bool>() == false);
   CHECK(rb[1].stages.at("hots").at("odometry_reused").get<bool>() == true);
+  CHECK(rb[1].stages.at("hots").at("base_prepared_reused").get<bool>() == true);
   CHECK(rb[0].T_base_target.isApprox(rb[1].T_base_target, 1e-12));
   CHECK(rb[0].status == rb[1].status);
   CHECK(rs[0].stages.at("hots").at("odometry_reused").get<bool>() == false);  // the default

@@ -14,6 +14,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "calibrate_test_util.hpp"
+#include "hots/refine_steps.hpp"
 #include "odometry/run_odometry.hpp"
 #include "pipeline/calibrate.hpp"
 #include "ulc/core/pose_error.hpp"
@@ -201,26 +202,34 @@ TEST_CASE("HOTS from the base's own odometry: run once, handed on, the joint one
   INFO(ulc::to_string(c.status) << ": " << c.reason);
   REQUIRE(c.success);
   REQUIRE(c.hots);
-  REQUIRE(c.base_odometry);
+  REQUIRE(c.base_work.odometry);
+  REQUIRE(c.base_work.hots);
   CHECK_FALSE(c.hots->odometry_reused);
-  CHECK(c.base_odometry->poses_a.size() == a.frames.size());
-  CHECK(c.base_odometry->poses_b.empty());  // a's alone: b's poses come from the extrinsic
+  CHECK_FALSE(c.hots->base_prepared_reused);
+  CHECK(c.base_work.odometry->poses_a.size() == a.frames.size());
+  CHECK(c.base_work.odometry->poses_b.empty());  // a's alone: b's poses come from the extrinsic
+  CHECK(c.base_work.hots->frames.size() == a.frames.size());
 
   // Handed to another call on the same base: not run again, and the same answer to the bit.
-  o.base_odometry = c.base_odometry;
+  o.base_work = c.base_work;
   const auto again = ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, o);
   REQUIRE(again.hots);
   CHECK(again.hots->odometry_reused);
-  CHECK(again.base_odometry == c.base_odometry);
+  CHECK(again.hots->base_prepared_reused);
+  CHECK(again.base_work.odometry == c.base_work.odometry);
+  CHECK(again.base_work.hots == c.base_work.hots);
+  CHECK(again.hots->statistics.windows == c.hots->statistics.windows);
+  CHECK(again.hots->statistics.planes == c.hots->statistics.planes);
   CHECK(same_bits(again.T_base_target, c.T_base_target));
   CHECK(again.time_offset_s == c.time_offset_s);
   const ulc::io::PairResult entry = ulc::io::to_pair_result(again, "lidar64", "lidar32");
   CHECK(entry.stages.at("hots").at("odometry_reused").get<bool>());
+  CHECK(entry.stages.at("hots").at("base_prepared_reused").get<bool>());
 
   // One that does not fit the base's frames is refused before any stage runs.
-  auto shorter = std::make_shared<odometry::OdometryResult>(*c.base_odometry);
+  auto shorter = std::make_shared<odometry::OdometryResult>(*c.base_work.odometry);
   shorter->poses_a.pop_back();
-  o.base_odometry = shorter;
+  o.base_work.odometry = shorter;
   const auto refused = ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, o);
   CHECK(refused.status == CalibrateStatus::invalid_input);
   CHECK_THAT(refused.reason, Catch::Contains("base odometry"));
@@ -229,12 +238,13 @@ TEST_CASE("HOTS from the base's own odometry: run once, handed on, the joint one
   // The multi-LiDAR odometry instead: both answers within 0.05 deg and 1 cm of each other
   // (measured: 0.0026 and 0.0029 deg, 0.6 and 0.7 mm off the truth), and within the bounds of
   // the test above.
-  o.base_odometry = nullptr;
+  o.base_work = {};
   o.tuning.hots_odometry = ulc::HotsOdometry::joint;
   const auto joint = ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, o);
   INFO(ulc::to_string(joint.status) << ": " << joint.reason);
   REQUIRE(joint.success);
-  CHECK_FALSE(joint.base_odometry);
+  CHECK_FALSE(joint.base_work.odometry);
+  CHECK_FALSE(joint.base_work.hots);
   const auto eb = ulc::pose_error(truth, c.T_base_target);
   const auto ej = ulc::pose_error(truth, joint.T_base_target);
   const auto between = ulc::pose_error(joint.T_base_target, c.T_base_target);

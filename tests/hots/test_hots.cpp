@@ -1,8 +1,10 @@
 // hots::refine on a short simulated 64-32 drive: from the truth disturbed by ~3 cm / 0.3 deg
 // (and odometry-like pose drift), the extrinsic comes back closer to the truth than it started,
-// and the refined poses are closer to the truth than the noisy ones.
+// and the refined poses are closer to the truth than the noisy ones; a's preparation handed to the
+// next call gives the same bits.
 #include <tbb/task_arena.h>
 #include <catch2/catch.hpp>
+#include <memory>
 #include <random>
 #include <vector>
 
@@ -101,6 +103,45 @@ TEST_CASE("refine improves a disturbed extrinsic on a simulated 64-32 drive", "[
   CHECK(after_a < 0.5 * before_a);
   CHECK(r.covariance_6x6.allFinite());
   CHECK(r.covariance_6x6.trace() > 0.0);
+}
+
+TEST_CASE("a's preparation handed from one refine to the next gives the same bits",
+          "[hots][refine][prepared]") {
+  const auto& a = drive().data.lidars[0];
+  const auto& b = drive().data.lidars[1];
+  const auto [C_gt, C0, pa, pb] = disturbed_start();
+  const hots::RefineOptions options;
+  const auto seq_a = ulc::make_sequence(a.frames, a.timestamps, pa);
+  const auto seq_b = ulc::make_sequence(b.frames, b.timestamps, pb);
+  auto same = [](const ulc::Isometry3d& x, const ulc::Isometry3d& y) {
+    return (x.matrix().array() == y.matrix().array()).all();
+  };
+  std::shared_ptr<hots::PreparedLidar<float>> prepared;
+  const hots::RefineResult first = hots::refine(seq_a, seq_b, C0, options, {}, &prepared);
+  REQUIRE(prepared);
+  CHECK(prepared->frames.size() == a.frames.size());
+  CHECK(hots::built_from(*prepared, pa));
+  const auto kept = prepared;
+  const hots::RefineResult second = hots::refine(seq_a, seq_b, C0, options, {}, &prepared);
+  CHECK(prepared == kept);  // used, not built again
+  CHECK(second.status == first.status);
+  CHECK(same(second.extrinsic, first.extrinsic));
+  CHECK(second.time_offset_s == first.time_offset_s);
+  CHECK(second.statistics.windows == first.statistics.windows);
+  CHECK(second.statistics.planes == first.statistics.planes);
+  REQUIRE(second.poses_a.size() == first.poses_a.size());
+  for (std::size_t k = 0; k < first.poses_a.size(); ++k)
+    CHECK(same(second.poses_a[k], first.poses_a[k]));
+  // Built from other poses: not used; a is prepared afresh, as without one.
+  auto moved = pa;
+  moved[3].translation().x() += 0.01;
+  const auto seq_moved = ulc::make_sequence(a.frames, a.timestamps, moved);
+  const hots::RefineResult third = hots::refine(seq_moved, seq_b, C0, options, {}, &prepared);
+  CHECK(prepared != kept);
+  CHECK(hots::built_from(*prepared, moved));
+  const hots::RefineResult fresh = hots::refine(seq_moved, seq_b, C0, options);
+  CHECK(same(third.extrinsic, fresh.extrinsic));
+  CHECK(third.statistics.planes == fresh.statistics.planes);
 }
 
 TEST_CASE("the whole-sequence step runs again from a start its answer's ellipsoid excludes",

@@ -234,6 +234,7 @@ inline Json hots_to_json(const HotsReport& h) {
   j["phase_seconds"] = std::move(phases);
   j["odometry_seconds"] = h.odometry_seconds;
   j["odometry_reused"] = h.odometry_reused;
+  j["base_prepared_reused"] = h.base_prepared_reused;
   j["seconds"] = h.seconds;
   return j;
 }
