@@ -116,6 +116,7 @@ RefineResult refine(const SeqA& a, const SeqB& b, const Isometry3d& extrinsic,
   RefineStatistics& st = result.statistics;
   const bool reusable = prepared_a && *prepared_a && built_from(**prepared_a, a.poses);
   d::RefineState<S> s(a, b, reusable ? *prepared_a : nullptr);
+  st.prepared_a_reused = reusable;
   s.start = extrinsic;
   s.mapa_mapb = d::map_b_in_map_a(s.a, s.b, extrinsic, options.time_offset_s);
   auto done = [&progress](double share) {

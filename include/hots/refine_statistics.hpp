@@ -109,6 +109,7 @@ struct RefineStatistics {
   std::size_t boundary_factors = 0;      ///< top-layer submap boundaries tied in the graph
   std::size_t boundary_links = 0;    ///< of those, by registering the submaps (the rest: odometry)
   std::size_t boundary_bridges = 0;  ///< boundaries tied by a bridge BA (not in boundary_factors)
+  bool prepared_a_reused = false;    ///< a's preparation came from the caller (refine's prepared_a)
   double graph_initial_cost = 0.0, graph_cost = 0.0;
   int graph_iterations = 0;
   double time_sync_spread = 0.0;

@@ -220,6 +220,7 @@ inline void add_refine(HotsReport& h, const hots::RefineResult& r, double second
   h.statistics = r.statistics;
   h.spread_curve = r.spread_curve;
   h.observability = hots_observability(r.statistics.sequence);
+  h.base_prepared_reused = r.statistics.prepared_a_reused;
   h.seconds = seconds;
 }
 
@@ -277,12 +278,12 @@ StageOutcome hots_step(const AttemptInputs<FA, FB>& in, Attempt& at) {
   const std::string odometry_stage = "odometry" + at.label, hots_stage = "hots" + at.label;
   auto t0 = std::chrono::steady_clock::now();
   notify(in.options, odometry_stage, 0.0);
-  const bool reused =
-      in.options.tuning.hots_odometry == HotsOdometry::base && in.base.odometry != nullptr;
+  const bool base_only = in.options.tuning.hots_odometry == HotsOdometry::base;
+  const bool odometry_reused = base_only && in.base.odometry != nullptr;
   const odometry::OdometryResult odo = hots_odometry(in, at.extrinsic, odometry_stage);
   at.out.timing_s.odometry = seconds_since(t0);
   at.out.hots = odometry_report(odo, at.extrinsic, at.out.timing_s.odometry);
-  at.out.hots->odometry_reused = reused;
+  at.out.hots->odometry_reused = odometry_reused;
   if (at.out.hots->run == HotsRun::odometry_failed)
     return failed_after_jeep(
         at, CalibrateStatus::hots_failed,
@@ -295,14 +296,11 @@ StageOutcome hots_step(const AttemptInputs<FA, FB>& in, Attempt& at) {
   a.poses = odo.poses_a;
   b.poses = odo.poses_b;
   t0 = std::chrono::steady_clock::now();
-  const bool base_only = in.options.tuning.hots_odometry == HotsOdometry::base;
-  const bool prepared = base_only && in.base.hots != nullptr;
   const hots::RefineResult h = hots::refine(
       a, b, at.extrinsic, in.hots, [&](double share) { notify(in.options, hots_stage, share); },
       base_only ? &in.base.hots : nullptr);
   at.out.timing_s.hots = seconds_since(t0);
   add_refine(*at.out.hots, h, at.out.timing_s.hots);
-  at.out.hots->base_prepared_reused = prepared;
   at.out.hots->time_offset_s += at.out.time_offset_s;  // back to b's own clock
   if (!h.ok())
     return failed_after_jeep(

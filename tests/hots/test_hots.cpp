@@ -124,6 +124,8 @@ TEST_CASE("a's preparation handed from one refine to the next gives the same bit
   const auto kept = prepared;
   const hots::RefineResult second = hots::refine(seq_a, seq_b, C0, options, {}, &prepared);
   CHECK(prepared == kept);  // used, not built again
+  CHECK_FALSE(first.statistics.prepared_a_reused);
+  CHECK(second.statistics.prepared_a_reused);
   CHECK(second.status == first.status);
   CHECK(same(second.extrinsic, first.extrinsic));
   CHECK(second.time_offset_s == first.time_offset_s);
@@ -138,6 +140,7 @@ TEST_CASE("a's preparation handed from one refine to the next gives the same bit
   const auto seq_moved = ulc::make_sequence(a.frames, a.timestamps, moved);
   const hots::RefineResult third = hots::refine(seq_moved, seq_b, C0, options, {}, &prepared);
   CHECK(prepared != kept);
+  CHECK_FALSE(third.statistics.prepared_a_reused);
   CHECK(hots::built_from(*prepared, moved));
   const hots::RefineResult fresh = hots::refine(seq_moved, seq_b, C0, options);
   CHECK(same(third.extrinsic, fresh.extrinsic));
