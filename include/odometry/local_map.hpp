@@ -127,45 +127,16 @@ class LocalMap {
     const int reach = static_cast<int>(std::ceil(max_distance / v));
     double best = max_distance * max_distance;
     const Slot* best_slot = nullptr;
-    if (reach <= 1 && interior(*key)) {
-      // The common case (gate <= voxel): the centre voxel, then its 26 neighbours, faces
-      // first, each skipped when its box is further than the best so far.
-      const auto centre = voxels_.position(*key);
-      if (centre) scan_voxel(*centre, query, best, best_slot);
-      const Vec3d lo = ulc::voxel_corner(*key, v);
-      double below[3], above[3];
-      for (int a = 0; a < 3; ++a) {
-        below[a] = (query[a] - lo[a]) * (query[a] - lo[a]);
-        above[a] = (lo[a] + v - query[a]) * (lo[a] + v - query[a]);
-      }
-      for (const auto& o : kNeighbours) {
-        double d2 = 0.0;
-        for (int a = 0; a < 3; ++a) d2 += o[a] < 0 ? below[a] : (o[a] > 0 ? above[a] : 0.0);
-        if (d2 > best) continue;
-        const auto pos =
-            voxels_.position(ulc::VoxelKey{key->x + o[0], key->y + o[1], key->z + o[2]});
-        if (pos) scan_voxel(*pos, query, best, best_slot);
-      }
-      if (!best_slot) return false;
-      out.point = best_slot->point.template cast<double>();
-      out.normal = best_slot->normal.template cast<double>();
-      return true;
+    int shell = 0;
+    if (interior(*key)) {
+      scan_block(*key, query, best, best_slot);  // shells 0 and 1, the common case
+      shell = 2;
     }
-    // Visit voxels by growing Chebyshev shells: once a shell's closest possible box is
-    // further than the best, no later shell can do better.
-    for (int shell = 0; shell <= reach; ++shell) {
+    // Further shells (a gate wider than a voxel), by growing Chebyshev distance: once a shell's
+    // closest possible box is further than the best, no later shell can do better.
+    for (; shell <= reach; ++shell) {
       if (shell >= 1 && (shell - 1) * v * (shell - 1) * v > best) break;
-      for (int dx = -shell; dx <= shell; ++dx)
-        for (int dy = -shell; dy <= shell; ++dy)
-          for (int dz = -shell; dz <= shell; ++dz) {
-            if (std::max({std::abs(dx), std::abs(dy), std::abs(dz)}) != shell) continue;
-            const auto neighbour = offset(*key, dx, dy, dz);
-            if (!neighbour) continue;
-            if (box_sq_distance(query, *neighbour) > best) continue;
-            const auto pos = voxels_.position(*neighbour);
-            if (!pos) continue;
-            scan_voxel(*pos, query, best, best_slot);
-          }
+      scan_shell(*key, shell, query, best, best_slot);
     }
     if (!best_slot) return false;
     out.point = best_slot->point.template cast<double>();
@@ -241,6 +212,43 @@ class LocalMap {
       d2 += d * d;
     }
     return d2;
+  }
+
+  /// The centre voxel of `key`, then its 26 neighbours, faces first, each skipped when its box is
+  /// further than the best so far. Every neighbour key must fit (interior(key)).
+  void scan_block(const ulc::VoxelKey& key, const Vec3d& q, double& best,
+                  const Slot*& best_slot) const {
+    const double v = options_.voxel_size;
+    const auto centre = voxels_.position(key);
+    if (centre) scan_voxel(*centre, q, best, best_slot);
+    const Vec3d lo = ulc::voxel_corner(key, v);
+    double below[3], above[3];
+    for (int a = 0; a < 3; ++a) {
+      below[a] = (q[a] - lo[a]) * (q[a] - lo[a]);
+      above[a] = (lo[a] + v - q[a]) * (lo[a] + v - q[a]);
+    }
+    for (const auto& o : kNeighbours) {
+      double d2 = 0.0;
+      for (int a = 0; a < 3; ++a) d2 += o[a] < 0 ? below[a] : (o[a] > 0 ? above[a] : 0.0);
+      if (d2 > best) continue;
+      const auto pos = voxels_.position(ulc::VoxelKey{key.x + o[0], key.y + o[1], key.z + o[2]});
+      if (pos) scan_voxel(*pos, q, best, best_slot);
+    }
+  }
+
+  /// The voxels at Chebyshev distance `shell` from `key`, each skipped when its box is further
+  /// than the best so far.
+  void scan_shell(const ulc::VoxelKey& key, int shell, const Vec3d& q, double& best,
+                  const Slot*& best_slot) const {
+    for (int dx = -shell; dx <= shell; ++dx)
+      for (int dy = -shell; dy <= shell; ++dy)
+        for (int dz = -shell; dz <= shell; ++dz) {
+          if (std::max({std::abs(dx), std::abs(dy), std::abs(dz)}) != shell) continue;
+          const auto neighbour = offset(key, dx, dy, dz);
+          if (!neighbour || box_sq_distance(q, *neighbour) > best) continue;
+          const auto pos = voxels_.position(*neighbour);
+          if (pos) scan_voxel(*pos, q, best, best_slot);
+        }
   }
 
   void scan_voxel(std::size_t pos, const Vec3d& q, double& best, const Slot*& best_slot) const {
