@@ -11,6 +11,8 @@
 //                             [--window 2] [--decimation 1] [--below-mask 100] [--seed 1]
 //                             [--no-motion] [--threads 2] [--json]
 //   ./build/bench/bench_terra --windows [--seed 1] [--pairs ...] [--starts 50] [--no-motion]
+//   ./build/bench/bench_terra --landscape [--pairs 64-32,64-tele] [--samples 5] [--grid-step 10]
+//                             [--png DIR]   (terra_landscape.hpp)
 //
 // Speed mode scenes: the synthetic crossroads of the tests (a 100k-point frame of an 80-beam
 // LiDAR, and a 32-beam target turned and 0.5 m away), and a simulated 64-32 frame pair
@@ -55,6 +57,7 @@
 #include "pipeline/calibrate.hpp"
 #include "support/bench_util.hpp"
 #include "terra/terra.hpp"
+#include "terra_landscape.hpp"
 #include "ulc/core/pose_error.hpp"
 #include "ulc/sim/sim.hpp"
 
@@ -492,6 +495,86 @@ int run_accuracy(const ulc_bench::Options& options, const AccuracyOptions& acc) 
 }
 
 // ---------------------------------------------------------------------------------------------
+
+struct LandscapeOptions {
+  std::vector<std::string> pairs = {"64-32", "64-tele"};
+  std::size_t samples = 5;
+  double spacing_s = 2.0;  ///< seconds between the frame pairs along the drive
+  double step_deg = 10.0;
+  std::string png;  ///< folder for the pictures; empty: none
+};
+
+/// One row per pair and distance (terra_landscape.hpp).
+int run_landscape(const ulc_bench::Options& options, const AccuracyOptions& acc,
+                  const LandscapeOptions& lo) {
+  namespace tl = terra_landscape;
+  ulc_bench::Table table({"pair", "distance", "samples", "truth_cell_deg", "minimum_median_deg",
+                          "minimum_within_15deg_pct", "truth_rank_median", "note"});
+  const terra::Lattice lattice(acc.lattice);
+  const tl::Grid grid(lo.step_deg);
+  const terra::SearchParams search;
+  for (const std::string& name : lo.pairs) {
+    std::string error;
+    const auto pairs = simulated_pairs(name, lo.samples, lo.spacing_s, acc.seed, error);
+    const char* names[3] = {"eq:feature_dis", "eq:feature_dis, overlap rule", "ED"};
+    const char* files[3] = {"feature_dis", "overlap_rule", "ed"};
+    std::vector<double> truth_cell, minimum[3], rank[3];
+    std::size_t within[3] = {0, 0, 0};
+    for (std::size_t k = 0; k < pairs.size(); ++k) {
+      const Pair& p = pairs[k];
+      const auto f1 = terra::make_descriptor(lattice, p.base, search.descriptor);
+      const auto f2 = terra::make_descriptor(lattice, p.target, search.descriptor);
+      const auto land = in_arena(acc.threads, [&] {
+        return tl::evaluate(lattice, f1, f2, acc.distance, grid, p.R_base_target);
+      });
+      double angle = 0.0, ruled_truth = 0.0;
+      const std::size_t cell = tl::nearest_cell(grid, p.R_base_target, angle);
+      truth_cell.push_back(angle);
+      const std::vector<double> ruled = tl::with_overlap_rule(land, acc.min_overlap, ruled_truth);
+      const std::vector<double>* d[3] = {&land.feature, &ruled, &land.euclidean};
+      const double at_truth[3] = {land.truth_feature, ruled_truth, land.truth_euclidean};
+      for (int m = 0; m < 3; ++m) {
+        const tl::Verdict v = tl::judge(grid, *d[m], at_truth[m], p.R_base_target);
+        minimum[m].push_back(v.minimum_error_deg);
+        rank[m].push_back(static_cast<double>(v.truth_rank));
+        within[m] += v.minimum_error_deg < 15.0;
+        if (k == 0 && !lo.png.empty())
+          tl::write_slice_png(lo.png + "/terra_landscape_" + name + "_" + files[m] + ".png", grid,
+                              *d[m], cell);
+      }
+      if (!options.json)
+        std::cerr << name << " pair " << k << ": grid minimum " << fmt(minimum[0].back(), 1)
+                  << " / " << fmt(minimum[1].back(), 1) << " / " << fmt(minimum[2].back(), 1)
+                  << " deg from the truth, the truth's rank " << rank[0].back() << " / "
+                  << rank[1].back() << " / " << rank[2].back() << " (" << names[0] << " / "
+                  << names[1] << " / " << names[2] << ")\n";
+    }
+    for (int m = 0; m < 3; ++m) {
+      const double n = static_cast<double>(pairs.size());
+      table.add_row({name, names[m], Cell::integer(long(pairs.size())),
+                     Cell::num(median(truth_cell), 1), Cell::num(median(minimum[m]), 1),
+                     Cell::num(n > 0 ? 100.0 * double(within[m]) / n : 0.0, 1),
+                     Cell::num(median(rank[m]), 0), error});
+    }
+  }
+  const ulc_bench::Machine m = ulc_bench::machine();
+  if (options.json) {
+    table.write_json(std::cout, "bench_terra_landscape", m, 1,
+                     {{"lattice", Cell::integer(long(acc.lattice))},
+                      {"seed", Cell::integer(long(acc.seed))},
+                      {"grid_step_deg", Cell::num(lo.step_deg, 1)},
+                      {"grid_rotations", Cell::integer(long(grid.size()))},
+                      {"min_overlap_ratio", Cell::num(acc.min_overlap, 2)}});
+  } else {
+    std::cout << "bench_terra --landscape: " << grid.size() << " rotations every " << lo.step_deg
+              << " deg (Euler ZYX); N = " << acc.lattice << ", d1 " << acc.distance.d1 << " m, d2 "
+              << acc.distance.d2 << " m, alpha " << acc.distance.alpha << "\n\n";
+    table.print(std::cout);
+  }
+  return 0;
+}
+
+// ---------------------------------------------------------------------------------------------
 // --maps: TERRA on frames vs on local maps (pipeline/map_terra.hpp) vs the automatic choice,
 // each through ulc::calibrate_pair with the terra stage alone.
 
@@ -753,6 +836,14 @@ int main(int argc, char** argv) {
   ulc_bench::Options options;
   ulc_bench::add_options(app, options);
   app.add_flag("--accuracy", accuracy, "TERRA against scancontext* on simulated rig pairs");
+  bool landscape = false;
+  LandscapeOptions lo;
+  app.add_flag("--landscape", landscape,
+               "eq:feature_dis against the Euclidean distance over a grid of rotations");
+  app.add_option("--grid-step", lo.step_deg, "--landscape: grid step in degrees (default 10)")
+      ->type_name("DEG")
+      ->check(CLI::Range(2.0, 90.0));
+  app.add_option("--png", lo.png, "--landscape: folder for the slice pictures")->type_name("DIR");
   app.add_flag("--maps", maps, "TERRA on frames against local maps");
   app.add_flag("--windows", windows,
                "issue 34's protocol: the eight paper pairs, 50 windows of 2 s, 1 s apart; frames, "
@@ -826,6 +917,11 @@ int main(int argc, char** argv) {
     mo.seed = acc.seed;
     mo.threads = acc.threads;
     return run_maps(options, mo);
+  }
+  if (landscape) {
+    if (pairs_given) lo.pairs = acc.pairs;
+    if (app.count("--samples") > 0) lo.samples = acc.samples;
+    return run_landscape(options, acc, lo);
   }
   return accuracy ? run_accuracy(options, acc) : run_speed(options);
 }

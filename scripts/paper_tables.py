@@ -11,6 +11,8 @@ into --out (one file per experiment, plus the benchmark's raw output beside it):
   terra-stride   the first stage's search stride
   terra-d1       d1 against the mount's translation, along and across the drive (the paper's
                  figure "impact of translation")
+  terra-landscape  eq:feature_dis against the Euclidean distance over a 10 deg grid of rotations
+                 (the paper's figure of distance landscapes; PNG slices)
   jeep-refine    scan-scan and JEEP from the paper's disturbance (5 deg, 2 m)
   jeep-maps      JEEP's 6x6 maps of rotation and translation disturbance (PNG pictures)
   jeep-frames    JEEP against its number of frames (PNG pictures)
@@ -175,6 +177,8 @@ def experiments(images):
         "terra-n": terra_n,
         "terra-stride": terra_stride,
         "terra-d1": terra_d1,
+        "terra-landscape": existing([["bench_terra", "--landscape", "--samples", "5", "--png",
+                                      images]]),
         "jeep-refine": existing([["bench_jeep", "--accuracy", "--starts", "50", "--threads", "2"]]),
         "jeep-maps": existing([["bench_jeep", "--robustness", "--threads", "2", "--png", images]]),
         "jeep-frames": existing([["bench_jeep", "--frames-sweep", "--threads", "2", "--png",
