@@ -18,8 +18,10 @@
 // separation: the acceptance rule's evidence (overlap, directional and off-ground overlap,
 //     condition) for the true data and for unrelated data (b's frames from the other half of
 //     the drive, relabelled in time).
-// (b) robustness: success over a 6x6 grid of initial rotation (0..12.5 deg) x translation
-//     (0..5 m) disturbance; --frames-sweep: success and errors for K = 2..12 at 5 deg, 2 m.
+// (b) robustness: success and median errors over a 6x6 grid of initial rotation (0..12.5 deg) x
+//     translation (0..5 m) disturbance (with --png, three maps per scenario: success in %,
+//     e_rot in millidegrees, e_trans in millimetres; the paper's figure); --frames-sweep: success
+//     and errors for K = 2..12 at 5 deg, 2 m.
 // (c) odometry: multi-LiDAR odometry over the drive with the true extrinsic: relative
 //     translation drift against the simulator's trajectory, and frame pairs per second on 1 and
 //     --threads threads.
@@ -390,18 +392,27 @@ void robustness(Config c) {
   const jeep::JeepOptions o = jeep_options(c, c.frames);
   for (const auto& scenario : c.scenarios) {
     const Drive d = load_drive(scenario, c);
-    ulc_bench::Heatmap map;  // rows: rotation disturbance, columns: translation disturbance
+    // Rows: rotation disturbance, columns: translation disturbance. Success in %; the median
+    // errors in millidegrees and millimetres, green at 0 and red at kRedMdeg / kRedMm.
+    constexpr double kRedMdeg = 50.0, kRedMm = 10.0;
+    ulc_bench::Heatmap success, rot, trans;
+    rot.red_at = kRedMdeg, rot.green_at = 0.0;
+    trans.red_at = kRedMm, trans.green_at = 0.0;
     for (int ri = 0; ri < 6; ++ri) {
-      map.row_labels.push_back(format_fixed(2.5 * ri, 1));
-      map.column_labels.push_back(format_fixed(1.0 * ri, 0));
-      map.values.emplace_back();
+      for (auto* m : {&success, &rot, &trans}) {
+        m->row_labels.push_back(format_fixed(2.5 * ri, 1));
+        m->column_labels.push_back(format_fixed(1.0 * ri, 0));
+        m->values.emplace_back();
+      }
       for (int ti = 0; ti < 6; ++ti) {
         const double deg = 2.5 * ri, metres = 1.0 * ti;
         Summary sum;
         for (std::size_t s : start_pairs(d, c.starts, c.frames))
           sum.add(run_jeep(window(d, s, c.frames), disturbance_for(d, c, s, deg, metres, 17),
                            d.truth, o, c.threads));
-        map.values.back().push_back(sum.pct(sum.successes));
+        success.values.back().push_back(sum.pct(sum.successes));
+        rot.values.back().push_back(1000 * jeep_test::median(sum.rot));
+        trans.values.back().push_back(1000 * jeep_test::median(sum.trans));
         table.add_row({scenario, Cell::num(deg, 1), Cell::num(metres, 1),
                        Cell::integer(static_cast<long long>(sum.runs)),
                        Cell::num(sum.pct(sum.successes), 1),
@@ -412,7 +423,9 @@ void robustness(Config c) {
                     << " m: " << sum.pct(sum.successes) << "%\n";
       }
     }
-    write_png(c, "jeep_robustness_" + scenario + ".png", map);
+    write_png(c, "jeep_robustness_" + scenario + ".png", success);
+    write_png(c, "jeep_robustness_" + scenario + "_e_rot_mdeg.png", rot);
+    write_png(c, "jeep_robustness_" + scenario + "_e_trans_mm.png", trans);
   }
   emit(table, "bench_jeep_robustness", c,
        {{"scenarios", scenario_list(c)},

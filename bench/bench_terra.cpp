@@ -54,6 +54,7 @@
 #include <vector>
 
 #include "../tests/terra/terra_test_util.hpp"
+#include "fpfh_baseline.hpp"
 #include "pipeline/calibrate.hpp"
 #include "support/bench_util.hpp"
 #include "terra/terra.hpp"
@@ -409,7 +410,21 @@ struct AccuracyOptions {
   double coarse_stride_deg = terra::SearchParams().coarse_stride_deg;
   terra::DistanceParams distance;
   std::optional<ulc::Vec3d> mount_offset;  ///< --mount-offset (move_target)
+  bool fpfh = false;                       ///< --fpfh: the FPFH + RANSAC baseline too
 };
+
+/// e_rot (deg) of the FPFH + RANSAC baseline (fpfh_baseline.hpp) on a frame pair; 180 when it
+/// finds nothing.
+double fpfh_error_deg(const Cloud& base, const Cloud& target, const ulc::Mat3d& truth,
+                      std::uint64_t seed, int threads) {
+  fpfh_baseline::Options o;
+  o.seed = seed;
+  return in_arena(threads, [&] {
+    const auto r = fpfh_baseline::register_frames(fpfh_baseline::describe(base, o),
+                                                  fpfh_baseline::describe(target, o), o);
+    return r.ok ? ulc::rotation_error_rad(truth, r.rotation) / kDeg : 180.0;
+  });
+}
 
 std::string offset_text(const std::optional<ulc::Vec3d>& offset) {
   if (!offset) return "the scenario's";
@@ -420,7 +435,8 @@ std::string offset_text(const std::optional<ulc::Vec3d>& offset) {
 
 int run_accuracy(const ulc_bench::Options& options, const AccuracyOptions& acc) {
   ulc_bench::Table table({"pair", "samples", "terra_success_pct", "terra_median_deg",
-                          "terra_mean_s", "sc_success_pct", "sc_median_deg", "sc_mean_s", "note"});
+                          "terra_mean_s", "sc_success_pct", "sc_median_deg", "sc_mean_s",
+                          "fpfh_success_pct", "fpfh_median_deg", "fpfh_mean_s", "note"});
   const terra::Lattice lattice(acc.lattice);
   terra::SearchParams params;
   params.adaptive_d1.enabled = acc.adaptive_d1;
@@ -433,12 +449,12 @@ int run_accuracy(const ulc_bench::Options& options, const AccuracyOptions& acc) 
     const auto pairs =
         simulated_pairs(name, acc.samples, acc.spacing_s, acc.seed, error, acc.mount_offset);
     if (pairs.empty()) {
-      table.add_row({name, "0", "", "", "", "", "", "", error});
+      table.add_row({name, "0", "", "", "", "", "", "", "", "", "", error});
       continue;
     }
-    std::vector<double> te, se;
-    double tt = 0, st = 0;
-    std::size_t ts = 0, ss = 0, adapted = 0;
+    std::vector<double> te, se, fe;
+    double tt = 0, st = 0, ft = 0;
+    std::size_t ts = 0, ss = 0, fs = 0, adapted = 0;
     for (std::size_t k = 0; k < pairs.size(); ++k) {
       const Pair& p = pairs[k];
       const std::uint64_t seed = acc.seed * 1000003u + k;
@@ -458,15 +474,26 @@ int run_accuracy(const ulc_bench::Options& options, const AccuracyOptions& acc) 
       const double e = sc.ok ? ulc::rotation_error_rad(c.truth, sc.rotation) / kDeg : 180.0;
       se.push_back(e);
       ss += e < ulc::kRotationInitMaxRotationDeg;
+      std::string fpfh_text;
+      if (acc.fpfh) {
+        const auto t1 = std::chrono::steady_clock::now();
+        const double f = fpfh_error_deg(p.base, turned, c.truth, seed, acc.threads);
+        ft += std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+        fe.push_back(f);
+        fs += f < ulc::kRotationInitMaxRotationDeg;
+        fpfh_text = ", fpfh " + fmt(f, 2) + " deg";
+      }
       if (!options.json)
         std::cerr << name << " sample " << k << ": terra " << fmt(c.error_deg, 2) << " deg (d1 "
-                  << fmt(c.result.stats.d1_used, 1) << "), scancontext* " << fmt(e, 2) << " deg\n";
+                  << fmt(c.result.stats.d1_used, 1) << "), scancontext* " << fmt(e, 2) << " deg"
+                  << fpfh_text << "\n";
     }
     const double n = double(pairs.size());
     table.add_row({name, Cell::integer(long(pairs.size())), Cell::num(100.0 * double(ts) / n, 1),
                    Cell::num(median(te), 2), Cell::num(tt / n, 3),
                    Cell::num(100.0 * double(ss) / n, 1), Cell::num(median(se), 2),
-                   Cell::num(st / n, 3),
+                   Cell::num(st / n, 3), acc.fpfh ? Cell::num(100.0 * double(fs) / n, 1) : "",
+                   acc.fpfh ? Cell::num(median(fe), 2) : "", acc.fpfh ? Cell::num(ft / n, 3) : "",
                    error.empty() ? "d1 adapted in " + std::to_string(adapted) : error});
   }
   const ulc_bench::Machine m = ulc_bench::machine();
@@ -836,6 +863,7 @@ int main(int argc, char** argv) {
   ulc_bench::Options options;
   ulc_bench::add_options(app, options);
   app.add_flag("--accuracy", accuracy, "TERRA against scancontext* on simulated rig pairs");
+  app.add_flag("--fpfh", acc.fpfh, "--accuracy: the FPFH + RANSAC baseline too");
   bool landscape = false;
   LandscapeOptions lo;
   app.add_flag("--landscape", landscape,

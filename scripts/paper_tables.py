@@ -5,8 +5,8 @@ Each experiment runs the benchmarks under the paper's protocol and writes its ta
 into --out (one file per experiment, plus the benchmark's raw output beside it):
 
   terra-pairs    TERRA on the eight pairs of the paper's figure: single frames (the paper's
-                 search, `bench_terra --accuracy`) and 2 s windows (the pipeline's TERRA stage,
-                 `bench_terra --windows`), scancontext* beside both
+                 search, `bench_terra --accuracy`, with scancontext* and FPFH + RANSAC beside it)
+                 and 2 s windows (the pipeline's TERRA stage, `bench_terra --windows`)
   terra-n        the lattice size N (the paper's table "impact of sampling number")
   terra-stride   the first stage's search stride
   terra-d1       d1 against the mount's translation, along and across the drive (the paper's
@@ -35,7 +35,8 @@ import sys
 
 EIGHT_PAIRS = ["64-32", "32-16", "64-horizon", "32-avia", "64-tele", "horizon-tele", "16-tele",
                "32-mid40"]
-SAMPLE = re.compile(r"^(\S+) sample \d+: terra ([0-9.]+) deg .*scancontext\* ([0-9.]+) deg")
+SAMPLE = re.compile(r"^(\S+) sample \d+: terra ([0-9.]+) deg .*scancontext\* ([0-9.]+) deg"
+                    r"(?:, fpfh ([0-9.]+) deg)?")
 
 
 def run(cmd, log):
@@ -76,9 +77,10 @@ class Sweep:
             for line in err.splitlines():
                 m = SAMPLE.match(line)
                 if m:
-                    pooled.setdefault(m.group(1), ([], []))
-                    pooled[m.group(1)][0].append(float(m.group(2)))
-                    pooled[m.group(1)][1].append(float(m.group(3)))
+                    pooled.setdefault(m.group(1), ([], [], []))
+                    for k in range(3):
+                        if m.group(k + 2) is not None:
+                            pooled[m.group(1)][k].append(float(m.group(k + 2)))
         return pooled
 
 
@@ -89,17 +91,20 @@ def table(header, rows):
 
 
 def terra_pairs(s, args):
-    errors = s.errors(EIGHT_PAIRS, [])
+    errors = s.errors(EIGHT_PAIRS, ["--fpfh"])
     rows = []
     for p in EIGHT_PAIRS:
-        t, sc = errors.get(p, ([], []))
+        t, sc, fpfh = errors.get(p, ([], [], []))
         if not t:
-            rows.append([p, "-", "-", "-"])
+            rows.append([p, "-", "-", "-", "-"])
             continue
-        rows.append([p, len(t), cell(*sr_and_error(t)), cell(*sr_and_error(sc))])
-    text = ("Single frames, the paper's search (`bench_terra --accuracy`, fixed d1 = 20 m): SR / "
-            "mean e_rot (deg) of the successes.\n\n" +
-            table(["pair", "samples", "TERRA", "scancontext*"], rows))
+        rows.append([p, len(t), cell(*sr_and_error(t)), cell(*sr_and_error(sc)),
+                     cell(*sr_and_error(fpfh))])
+    text = ("Single frames, the paper's search (`bench_terra --accuracy --fpfh`, fixed d1 = 20 m): "
+            "SR / mean e_rot (deg) of the successes.\n\n" +
+            table(["pair", "samples", "TERRA", "scancontext*", "FPFH + RANSAC"], rows))
+    if args.no_windows:
+        return text
     for seed in s.seeds:
         out, _ = run([os.path.join(s.bench, "bench_terra"), "--windows", "--seed", str(seed),
                       "--threads", str(s.threads)], s.log)
@@ -206,6 +211,8 @@ def main():
     p.add_argument("--seeds", type=int, nargs="+", default=[1, 2])
     p.add_argument("--samples", type=int, default=50, help="TERRA samples per pair and seed")
     p.add_argument("--threads", type=int, default=2)
+    p.add_argument("--no-windows", action="store_true",
+                   help="terra-pairs: the single frames only (the 2 s windows take an hour)")
     args = p.parse_args()
     known = experiments(args.images)
     names = args.only.split(",") if args.only else list(known)
