@@ -135,15 +135,18 @@ inline Verdict judge(const Grid& grid, const std::vector<double>& d, double at_t
   return v;
 }
 
-/// The yaw x pitch slice at the truth cell's roll, coloured by rank (dark = small distance),
-/// the truth's cell outlined in red; `cell` pixels per grid step.
+/// The yaw x pitch slice at the truth cell's roll, coloured by rank among the slice's finite
+/// values (dark = small distance; white: no overlap), the truth's cell outlined in red; `cell`
+/// pixels per grid step.
 inline bool write_slice_png(const std::string& path, const Grid& grid, const std::vector<double>& d,
                             std::size_t truth_cell, int cell = 14) {
   const std::size_t k = truth_cell % grid.roll.size();
   std::vector<double> slice;
   for (std::size_t i = 0; i < grid.yaw.size(); ++i)
     for (std::size_t j = 0; j < grid.pitch.size(); ++j) slice.push_back(d[grid.at(i, j, k)]);
-  std::vector<double> sorted = slice;
+  std::vector<double> sorted;  // the finite values: ranks among the rotations that score
+  for (double v : slice)
+    if (std::isfinite(v)) sorted.push_back(v);
   std::sort(sorted.begin(), sorted.end());
   const int w = static_cast<int>(grid.yaw.size()) * cell,
             h = static_cast<int>(grid.pitch.size()) * cell;

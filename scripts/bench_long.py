@@ -9,7 +9,7 @@ ground truth (`ulc evaluate --json`) and prints one row per drive: peak resident
 time, CPU time (user + system: the work, less sensitive than the wall time to other jobs on the
 machine), the load average at the end, the survey's time, the stretch calibrated on, e_rot,
 e_trans and the clock offset's error. --svg draws memory and time against length. Simulated drives take about 1.3 GB of disk per minute: --remove deletes
-each one after its row.
+each one after its row; --merge adds the rows of earlier runs (their --json) to the plot.
 
   scripts/bench_long.py --ulc build/apps/ulc/ulc --minutes 1 2 5 10 --work /tmp/long \
       --threads 2 --svg docs/images/long_drives.svg
@@ -127,6 +127,8 @@ def main():
     p.add_argument("--svg")
     p.add_argument("--json", help="write the rows here")
     p.add_argument("--remove", action="store_true", help="delete each simulated drive after use")
+    p.add_argument("--merge", nargs="+", default=[],
+                   help="--json files of earlier runs: their rows join the plot and the --json")
     a = p.parse_args()
     rows = []
     print(f"{'min':>5} {'peak GB':>8} {'wall s':>7} {'cpu s':>7} {'load':>5} {'survey s':>8} "
@@ -150,6 +152,10 @@ def main():
               flush=True)
         if a.remove:
             shutil.rmtree(folder)
+    for path in a.merge:
+        with open(path) as f:
+            rows += json.load(f)
+    rows.sort(key=lambda r: r["minutes"])
     if a.svg:
         svg_plot(rows, a.svg)
     if a.json:
