@@ -10,15 +10,14 @@
 //     to sum 100; FPFH(p) = SPFH(p) + mean over neighbours q of SPFH(q) / |p - q|;
 //   - each target feature matched to its nearest base feature (L2), kept when mutual;
 //   - RANSAC: 3 matches per draw, an edge-length check (each side within 10 %), the rigid
-//     transform of the three (Kabsch), scored by the matches within inlier_distance; the best
-//     transform refitted on its inliers. Seeded: the same answer for the same input.
+//     transform of the three (Eigen::umeyama), scored by the matches within inlier_distance; the
+//     best transform refitted on its inliers. Seeded: the same answer for the same input.
 #pragma once
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <Eigen/Geometry>
-#include <Eigen/SVD>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -113,20 +112,15 @@ inline std::size_t nearest_feature(const Feature& f, const std::vector<Feature>&
   return best;
 }
 
-/// R, t with R a + t = b for the pairs (Kabsch).
+/// R, t with R a + t = b for the pairs, least squares (Eigen::umeyama without scaling).
 inline void rigid_fit(const std::vector<Vec3d>& a, const std::vector<Vec3d>& b, Mat3d& R,
                       Vec3d& t) {
-  Vec3d ca = Vec3d::Zero(), cb = Vec3d::Zero();
-  for (std::size_t i = 0; i < a.size(); ++i) ca += a[i], cb += b[i];
-  ca /= double(a.size());
-  cb /= double(b.size());
-  Mat3d H = Mat3d::Zero();
-  for (std::size_t i = 0; i < a.size(); ++i) H += (a[i] - ca) * (b[i] - cb).transpose();
-  const Eigen::JacobiSVD<Mat3d> svd(H, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Mat3d D = Mat3d::Identity();
-  D(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0 ? -1.0 : 1.0;
-  R = svd.matrixV() * D * svd.matrixU().transpose();
-  t = cb - R * ca;
+  Eigen::Matrix3Xd from(3, static_cast<Eigen::Index>(a.size())), to(3, from.cols());
+  for (std::size_t i = 0; i < a.size(); ++i)
+    from.col(static_cast<Eigen::Index>(i)) = a[i], to.col(static_cast<Eigen::Index>(i)) = b[i];
+  const Eigen::Matrix4d T = Eigen::umeyama(from, to, false);
+  R = T.topLeftCorner<3, 3>();
+  t = T.topRightCorner<3, 1>();
 }
 
 }  // namespace detail
@@ -150,12 +144,15 @@ Described describe(const Cloud& cloud, const Options& o) {
   const ulc::KdTree<std::vector<Vec3d>> kept(d.points);
   std::vector<std::vector<std::size_t>> near(d.points.size());
   std::vector<Feature> simple(d.points.size());
-  tbb::parallel_for(std::size_t{0}, d.points.size(), [&](std::size_t i) {
-    std::vector<double> sq;
-    kept.radius(d.points[i], o.feature_radius, near[i], sq);
-    if (near[i].size() > o.max_neighbours) near[i].resize(o.max_neighbours);
-    simple[i] = detail::spfh(d, i, near[i]);
-  });
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, d.points.size(), 256),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      std::vector<double> sq;  // the search's distances, unused
+                      for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                        kept.radius(d.points[i], o.feature_radius, near[i], sq);
+                        if (near[i].size() > o.max_neighbours) near[i].resize(o.max_neighbours);
+                        simple[i] = detail::spfh(d, i, near[i]);
+                      }
+                    });
   d.features.resize(d.points.size());
   tbb::parallel_for(std::size_t{0}, d.points.size(), [&](std::size_t i) {
     Feature f = simple[i];
