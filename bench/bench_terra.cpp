@@ -6,7 +6,7 @@
 //   ./build/bench/bench_terra --accuracy [--pairs 64-32,32-16] [--samples 50] [--seed 1]
 //                             [--lattice 10000] [--[no-]adaptive-d1] [--min-overlap 0.2]
 //                             [--top-k 10] [--coarse-stride 10] [--d1 20] [--d2 5]
-//                             [--alpha 2] [--mount-offset X,Y,Z] [--threads 2] [--json]
+//                             [--alpha 2] [--mount-offset X,Y,Z] [--fpfh] [--threads 2] [--json]
 //   ./build/bench/bench_terra --maps [--pairs 64-tele,...] [--starts 8] [--spacing 3]
 //                             [--window 2] [--decimation 1] [--below-mask 100] [--seed 1]
 //                             [--no-motion] [--threads 2] [--json]
@@ -25,7 +25,8 @@
 // --mount-offset X,Y,Z moves the target to the base's position plus this offset (metres, vehicle
 // frame: x forward, along the drive; y left), keeping its orientation: the paper's ablation of
 // TERRA against the mount's translation (its d1 figure). Each LiDAR's housing blocks the other's
-// rays, so offsets under the housings' size leave the target blind.
+// rays, so offsets under the housings' size leave the target blind. --fpfh adds the FPFH + RANSAC
+// baseline (fpfh_baseline.hpp) on the same turned targets.
 //
 // Maps mode: for each pair scenario, --starts windows of --window seconds spread along a drive,
 // the target's frames turned by a uniform random rotation per window; ulc::calibrate_pair
@@ -565,9 +566,11 @@ int run_landscape(const ulc_bench::Options& options, const AccuracyOptions& acc,
         minimum[m].push_back(v.minimum_error_deg);
         rank[m].push_back(static_cast<double>(v.truth_rank));
         within[m] += v.minimum_error_deg < 15.0;
-        if (k == 0 && !lo.png.empty())
-          tl::write_slice_png(lo.png + "/terra_landscape_" + name + "_" + files[m] + ".png", grid,
-                              *d[m], cell);
+        if (k == 0 && !lo.png.empty()) {
+          const std::string path = lo.png + "/terra_landscape_" + name + "_" + files[m] + ".png";
+          if (!tl::write_slice_png(path, grid, *d[m], cell))
+            std::cerr << "bench_terra: could not write " << path << "\n";
+        }
       }
       if (!options.json)
         std::cerr << name << " pair " << k << ": grid minimum " << fmt(minimum[0].back(), 1)

@@ -1,6 +1,6 @@
 // bench_terra --landscape: the paper's figure of rotations and their distances, in numbers. Over
 // a grid of rotations (Euler angles R = Rz(yaw) Ry(pitch) Rx(roll), every `step` degrees) it
-// evaluates two distances between the base frame's descriptor F1 and the target's turned by the
+// evaluates three distances between the base frame's descriptor F1 and the target's turned by the
 // rotation, G = rotate(F2, R):
 //   - eq:feature_dis, the paper's (masked by eq:mask, divided by the mask count to the alpha);
 //   - the same with ULC's overlap rule (terra/search_params.hpp, min_overlap_ratio): rotations
@@ -10,8 +10,8 @@
 // the ground truth's own distance among the grid's: 1 when no grid rotation scores better than
 // the truth (the truth is the global optimum, as far as the grid can tell). With a picture folder,
 // the first pair of each scenario is drawn: the distance over yaw (x) and pitch (y) at the grid
-// roll nearest the truth's, coloured by rank within the slice (dark = small distance), the truth's
-// cell marked in red.
+// roll nearest the truth's, coloured by rank among the slice's scoring rotations (dark = small
+// distance, white = no overlap), the truth's cell marked in red.
 #pragma once
 
 #include <algorithm>
