@@ -81,6 +81,10 @@ class Sweep:
                     for k in range(3):
                         if m.group(k + 2) is not None:
                             pooled[m.group(1)][k].append(float(m.group(k + 2)))
+            missing = [p for p in pairs if p not in pooled]
+            if missing:
+                sys.exit(f"paper_tables: {' '.join(cmd)} gave no samples for "
+                         f"{', '.join(missing)} (see {self.log})")
         return pooled
 
 
@@ -94,10 +98,7 @@ def terra_pairs(s, args):
     errors = s.errors(EIGHT_PAIRS, ["--fpfh"])
     rows = []
     for p in EIGHT_PAIRS:
-        t, sc, fpfh = errors.get(p, ([], [], []))
-        if not t:
-            rows.append([p, "-", "-", "-", "-"])
-            continue
+        t, sc, fpfh = errors[p]
         rows.append([p, len(t), cell(*sr_and_error(t)), cell(*sr_and_error(sc)),
                      cell(*sr_and_error(fpfh))])
     text = ("Single frames, the paper's search (`bench_terra --accuracy --fpfh`, fixed d1 = 20 m): "
@@ -121,7 +122,7 @@ def terra_n(s, args):
             [f"{math.degrees(math.sqrt(4 * math.pi / n)):.2f}" for n in sizes]]
     for p in pairs:
         rows.append([f"{p}: SR / e_rot"] +
-                    [cell(*sr_and_error(results[n].get(p, ([180.0], []))[0])) for n in sizes])
+                    [cell(*sr_and_error(results[n][p][0])) for n in sizes])
     return ("The lattice size N, single frames (fixed d1 = 20 m, coarse stride 10 deg): SR / "
             "mean e_rot (deg) of the successes.\n\n" + table(header, rows))
 
@@ -131,7 +132,7 @@ def terra_stride(s, args):
     strides = [5, 10, 20, 30]
     results = {d: s.errors(pairs, ["--coarse-stride", str(d)]) for d in strides}
     rows = [[f"{p}: SR / e_rot"] +
-            [cell(*sr_and_error(results[d].get(p, ([180.0], []))[0])) for d in strides]
+            [cell(*sr_and_error(results[d][p][0])) for d in strides]
             for p in pairs]
     return ("The first stage's stride, single frames (N = 10000, fixed d1 = 20 m): SR / mean "
             "e_rot (deg) of the successes.\n\n" +
