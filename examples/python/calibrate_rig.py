@@ -5,9 +5,10 @@
 
 Prints the extrinsic found next to the simulator's truth. The simulated LiDARs share one clock,
 which the call is told (synced_clocks=True): a 20 s drive is too short to estimate an offset
-(--estimate-offset tries, and says so when the drive does not pin it). With Open3D (Debian's python3-open3d)
-and a display, it opens two windows: the base's first frame (grey) with the target's placed by
-no guess (identity), then by the calibration (orange). Without either, it skips the windows.
+(--estimate-offset tries, and says so when the drive does not pin it). With Open3D (Debian's
+python3-open3d) and a display, it opens two windows: the base's first frame (grey) with the
+target's placed by no guess (identity), then by the calibration (orange). Without either, it
+skips the windows.
 """
 import argparse
 import os
