@@ -239,6 +239,15 @@ inline Mat6d plane_hessian_block(const PlaneForms& f, const Eigen::Matrix<double
   return block;
 }
 
+/// H(a, b) += block and, for a pair of distinct variables (mirror), H(b, a) += block^T.
+/// plane_hessian_block(b, a) is plane_hessian_block(a, b)^T to the bit (the same products,
+/// summed in the same order), so a caller summing a plane's blocks visits each pair once.
+inline void add_symmetric_block(Eigen::MatrixXd& H, Eigen::Index a, Eigen::Index b,
+                                const Mat6d& block, bool mirror) {
+  H.block<6, 6>(a, b) += block;
+  if (mirror) H.block<6, 6>(b, a) += block.transpose();
+}
+
 /// Cost, gradient and Hessian of one plane (see the header comment and PlaneForms).
 inline PlaneDerivatives evaluate_plane(const std::vector<FrameCluster>& frames,
                                        const std::vector<Isometry3d>& poses, const Vec3d& c,

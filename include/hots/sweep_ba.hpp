@@ -151,9 +151,9 @@ window_ba_detail::Sums evaluate(const std::vector<Plane>& planes, const SweepWin
         for (std::size_t i = 0; i < vars.size(); ++i) {
           const auto ia = static_cast<Eigen::Index>(6 * vars[i]);
           acc.g.template segment<6>(ia) += W[i].col(0);
-          for (std::size_t j = 0; j < vars.size(); ++j)
-            acc.H.template block<6, 6>(ia, static_cast<Eigen::Index>(6 * vars[j])) +=
-                plane_hessian_block(f, W[i], E[i], W[j], E[j]);
+          for (std::size_t j = i; j < vars.size(); ++j)
+            add_symmetric_block(acc.H, ia, static_cast<Eigen::Index>(6 * vars[j]),
+                                plane_hessian_block(f, W[i], E[i], W[j], E[j]), j != i);
         }
       });
   out.H = 0.5 * (out.H + out.H.transpose());

@@ -117,11 +117,11 @@ inline Sums evaluate(const std::vector<Plane>& planes, const std::vector<Isometr
                       for (std::size_t a = 0; a < plane.frames.size(); ++a) {
                         const auto ia = static_cast<Eigen::Index>(6 * plane.frames[a].frame);
                         acc.g.segment<6>(ia) += f.w[a].col(0);
-                        for (std::size_t b = 0; b < plane.frames.size(); ++b) {
+                        for (std::size_t b = a; b < plane.frames.size(); ++b) {
                           Mat6d block = plane_hessian_block(f, f.w[a], f.e[a], f.w[b], f.e[b]);
                           if (a == b) block += f.own[a];
                           const auto ib = static_cast<Eigen::Index>(6 * plane.frames[b].frame);
-                          acc.H.block<6, 6>(ia, ib) += block;
+                          add_symmetric_block(acc.H, ia, ib, block, b != a);
                         }
                       }
                     });

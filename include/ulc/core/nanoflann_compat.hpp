@@ -111,7 +111,10 @@ class KnnResultSet {
   KnnResultSet(std::size_t capacity, std::size_t* indices, S* sq_dists)
       : capacity_(capacity), indices_(indices), dists_(sq_dists) {}
 
-  void init() { count_ = 0; }
+  void init() {
+    count_ = 0;
+    worst_ = std::numeric_limits<S>::infinity();
+  }
   std::size_t size() const { return count_; }
   bool empty() const { return count_ == 0; }
   bool full() const { return count_ == capacity_; }
@@ -126,18 +129,19 @@ class KnnResultSet {
     }
     dists_[i] = dist;
     indices_[i] = index;
+    if (full()) worst_ = just_above(dists_[count_ - 1]);
     return true;  // keep searching
   }
 
-  S worstDist() const {
-    return full() ? just_above(dists_[count_ - 1]) : std::numeric_limits<S>::infinity();
-  }
+  /// Kept up to date by addPoint: nanoflann asks for it at every node it visits.
+  S worstDist() const { return worst_; }
 
  private:
   std::size_t capacity_;
   std::size_t count_ = 0;
   std::size_t* indices_;
   S* dists_;
+  S worst_ = std::numeric_limits<S>::infinity();
 };
 
 /// Every point with squared distance <= radius^2 (closed ball), unsorted; the caller sorts.

@@ -39,25 +39,29 @@ class NearestWithin {
   using IndexType = std::size_t;
   using CountType = std::size_t;
 
-  explicit NearestWithin(S sq_bound) : best_(sq_bound) {}
+  explicit NearestWithin(S sq_bound)
+      : best_(sq_bound), worst_(nanoflann_compat::just_above(sq_bound)) {}
   void init() {}
   std::size_t size() const { return found_ ? 1 : 0; }
   bool full() const { return true; }
   bool addPoint(S dist, std::size_t index) {
     if (dist < best_ || (dist == best_ && (!found_ || index < index_))) {
       best_ = dist;
+      worst_ = nanoflann_compat::just_above(dist);
       index_ = index;
       found_ = true;
     }
     return true;
   }
-  S worstDist() const { return nanoflann_compat::just_above(best_); }
+  /// Kept up to date by addPoint: nanoflann asks for it at every node it visits.
+  S worstDist() const { return worst_; }
 
   bool found() const { return found_; }
   std::size_t index() const { return index_; }
 
  private:
   S best_;
+  S worst_;  ///< just above best_
   std::size_t index_ = 0;
   bool found_ = false;
 };
