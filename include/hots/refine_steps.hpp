@@ -522,21 +522,19 @@ RefineStatus solve_passes(RefineState<S>& s, const RefineOptions& options, Refin
 /// it began and its jackknife, the local curvature, sees nothing (bench_covariance, side-bpearl
 /// seed 5, 10 s: from the graph's C the step ended 29 cm off along the drive with sigma 2.6 cm;
 /// from JEEP's, 0.3 cm off, it ended 6.3 cm off; the two costs 0.4 % apart).
+/// The rerun shares the step's prepared submaps and frames (SequenceStep::solve_extrinsic).
 template <typename S>
-Vec6d rerun_from_start(const RefineState<S>& s, const SequenceExtrinsicOptions& so, double start_dt,
-                       const Mat6d& covariance, RefineResult& result,
-                       const ulc::StepProgress& progress) {
+Vec6d rerun_from_start(const RefineState<S>& s, SequenceStep<S>& step, const Mat6d& covariance,
+                       RefineResult& result) {
   const Vec6d away = ulc::se3_log(Isometry3d(s.start * result.extrinsic.inverse()));
   if (ulc::within_three_sigma(away, covariance)) return Vec6d::Zero();
   SequenceExtrinsicResult& rerun = result.statistics.sequence_rerun;
-  rerun = sequence_extrinsic(s.a.hierarchy, s.a.frames, s.a.times, graph_poses(s, s.a), s.b.frames,
-                             s.b.times, s.start, start_dt, so, progress);
+  rerun = step.solve_extrinsic(s.start);
   if (!rerun.ok()) return Vec6d::Zero();
   return ulc::se3_log(Isometry3d(rerun.extrinsic * result.extrinsic.inverse()));
 }
 
-/// False when it failed (result.reason says why). progress gets the fraction done: the step to
-/// 0.8, its rerun (when it runs) the rest.
+/// False when it failed (result.reason says why). progress gets the step's fraction done.
 template <typename S>
 bool sequence_step(RefineState<S>& s, const RefineOptions& options, RefineResult& result,
                    const ulc::StepProgress& progress) {
@@ -548,10 +546,10 @@ bool sequence_step(RefineState<S>& s, const RefineOptions& options, RefineResult
   // Without synchronisation the offset is the caller's (known clocks): nothing to check.
   so.check_time_offset = so.check_time_offset && options.synchronise_time;
   const auto t0 = std::chrono::steady_clock::now();
-  const double start_dt = result.time_offset_s;
-  st.sequence = sequence_extrinsic(s.a.hierarchy, s.a.frames, s.a.times, graph_poses(s, s.a),
-                                   s.b.frames, s.b.times, result.extrinsic, result.time_offset_s,
-                                   so, ulc::progress_within(progress, 0.0, 0.8));
+  const std::vector<Isometry3d> world_a = graph_poses(s, s.a);
+  SequenceStep<S> step(s.a.hierarchy, s.a.frames, s.a.times, world_a, s.b.frames, s.b.times,
+                       result.time_offset_s, so, progress);
+  st.sequence = step.solve(result.extrinsic, progress);
   if (!st.sequence.ok()) {
     result.reason = st.sequence.reason;
     return false;
@@ -567,8 +565,7 @@ bool sequence_step(RefineState<S>& s, const RefineOptions& options, RefineResult
     // a rank-one term (hots.hpp).
     const Vec6d moved = ulc::se3_log(Isometry3d(graph_answer * result.extrinsic.inverse()));
     result.covariance_6x6 = st.sequence.covariance_6x6 + moved * moved.transpose();
-    const Vec6d rerun = rerun_from_start(s, so, start_dt, result.covariance_6x6, result,
-                                         ulc::progress_within(progress, 0.8, 1.0));
+    const Vec6d rerun = rerun_from_start(s, step, result.covariance_6x6, result);
     result.covariance_6x6 += rerun * rerun.transpose();
   }
   st.sequence_seconds =

@@ -563,6 +563,7 @@ void check_offset(SequenceProblem<S>& problem, const Solve& s, double dt0,
       result.half_time_offset_s[h] = half.ok ? half.dt : s.dt;
     }
     problem.set_span(0, n);
+    problem.match({s.C, s.dt});  // the whole drive's terms again, for the result's statistics
     if (!halves_ok)
       result.time_offset_doubt = "a half of the drive could not be registered on its own";
     else if (std::abs(result.half_time_offset_s[0] - result.half_time_offset_s[1]) >
@@ -621,10 +622,105 @@ void take_solve(const Solve& s, const SequenceProblem<S>& problem,
 
 }  // namespace sequence_detail
 
-/// See the header comment. world_a: T_world_a after the pose graph; frames_b: b's prepared
-/// (deskewed, downsampled) frames in b's body frame at times_b. progress (optional) is called
-/// on the calling thread after each of its six sub-steps (submaps, problem, solve, offset
-/// check, solve without the offset, covariance), as equal fractions.
+/// The whole-sequence step over one base trajectory and one starting offset dt0, prepared once
+/// (the base's submaps with their planes, b's thinned frames: most of a solve's cost) and
+/// solved from one or more starts C0. world_a: T_world_a after the pose graph; frames_b: b's
+/// prepared (deskewed, downsampled) frames in b's body frame at times_b. The inputs must
+/// outlive it.
+template <typename S>
+class SequenceStep {
+ public:
+  /// progress (optional) gets 1/6 after the submaps and 2/6 after the frames (solve's six
+  /// sub-steps continue it).
+  SequenceStep(const HierarchyResult<S>& ha, const std::vector<std::vector<ulc::Vec3<S>>>& frames_a,
+               const std::vector<double>& times_a, const std::vector<Isometry3d>& world_a,
+               const std::vector<std::vector<ulc::Vec3<S>>>& frames_b,
+               const std::vector<double>& times_b, double dt0,
+               const SequenceExtrinsicOptions& o = {}, const ulc::StepProgress& progress = {})
+      : o_(o), dt0_(dt0) {
+    namespace d = sequence_detail;
+    if (!o.enabled) return;
+    const Isometry3d any_start = Isometry3d::Identity();
+    input_error_ =
+        d::input_problem(frames_a, times_a, world_a, frames_b, times_b, any_start, dt0, o);
+    if (input_error_) return;
+    submaps_ = d::base_submaps(ha, frames_a, times_a, o);
+    if (submaps_.planes.empty()) {
+      input_error_ = "no submaps";
+      return;
+    }
+    if (progress) progress(1.0 / 6.0);
+    problem_.emplace(d::sequence_problem(submaps_, times_a, world_a, frames_b, times_b, dt0, o_));
+    if (progress) progress(2.0 / 6.0);
+  }
+  SequenceStep(const SequenceStep&) = delete;
+  SequenceStep& operator=(const SequenceStep&) = delete;
+
+  /// See the header comment. progress (optional) gets 3/6 .. 6/6 after the solve, the offset
+  /// check, the solve without the offset and the covariance.
+  SequenceExtrinsicResult solve(const Isometry3d& C0, const ulc::StepProgress& progress = {}) {
+    return run(C0, true, progress);
+  }
+
+  /// The extrinsic alone from another start: solve()'s solves, to the same answer, without the
+  /// offset's trust check and the covariance (what a second start is asked for: where it ends).
+  SequenceExtrinsicResult solve_extrinsic(const Isometry3d& C0) { return run(C0, false, {}); }
+
+ private:
+  SequenceExtrinsicResult run(const Isometry3d& C0, bool full, const ulc::StepProgress& progress) {
+    namespace d = sequence_detail;
+    auto done = [&progress](int sub_steps) {
+      if (progress) progress(sub_steps / 6.0);
+    };
+    SequenceExtrinsicResult result;
+    result.extrinsic = C0;
+    result.time_offset_s = result.joint_time_offset_s = dt0_;
+    if (!o_.enabled) return result;
+    auto fail = [&](SequenceExtrinsicStatus status, const char* why) {
+      result.status = status;
+      result.reason = why;
+      result.extrinsic = C0;
+      result.time_offset_s = dt0_;
+      return result;
+    };
+    if (!C0.matrix().allFinite())
+      return fail(SequenceExtrinsicStatus::invalid_input, "bad inputs or options");
+    if (input_error_) return fail(SequenceExtrinsicStatus::invalid_input, input_error_);
+    result.targets = submaps_.planes.size();
+    auto& problem = *problem_;
+    const bool joint = o_.estimate_time_offset || o_.check_time_offset;
+    d::Solve s = d::solve(problem, C0, dt0_, joint, o_, result.iterations);
+    if (!s.ok) return fail(SequenceExtrinsicStatus::registration_failed, s.reason);
+    if (joint) d::judge_joint_offset(s, dt0_, o_, result);
+    done(3);
+    if (full && o_.check_time_offset) d::check_offset(problem, s, dt0_, o_, result);
+    done(4);
+    if (joint && !result.time_offset_refined) {
+      s = d::solve(problem, C0, dt0_, false, o_, result.iterations);
+      if (!s.ok) return fail(SequenceExtrinsicStatus::registration_failed, s.reason);
+    }
+    done(5);
+    d::take_solve(s, problem, result);
+    if (!full) return result;
+    if (const auto c =
+            d::extrinsic_covariance(problem, s, joint && result.time_offset_refined, o_)) {
+      result.covariance_6x6 = *c;
+      result.has_covariance = true;
+    }
+    done(6);
+    return result;
+  }
+
+  SequenceExtrinsicOptions o_;
+  double dt0_ = 0.0;
+  const char* input_error_ = nullptr;  ///< why no solve can run; nullptr when one can
+  sequence_detail::BaseSubmaps<S> submaps_;
+  std::optional<sequence_detail::SequenceProblem<S>> problem_;  ///< reads submaps_ and o_
+};
+
+/// See the header comment: SequenceStep's solve from C0, for a single start. progress
+/// (optional) is called on the calling thread after each of its six sub-steps (submaps,
+/// problem, solve, offset check, solve without the offset, covariance), as equal fractions.
 template <typename S>
 SequenceExtrinsicResult sequence_extrinsic(const HierarchyResult<S>& ha,
                                            const std::vector<std::vector<ulc::Vec3<S>>>& frames_a,
@@ -634,48 +730,8 @@ SequenceExtrinsicResult sequence_extrinsic(const HierarchyResult<S>& ha,
                                            const std::vector<double>& times_b, const Isometry3d& C0,
                                            double dt0, const SequenceExtrinsicOptions& o = {},
                                            const ulc::StepProgress& progress = {}) {
-  namespace d = sequence_detail;
-  auto done = [&progress](int sub_steps) {
-    if (progress) progress(sub_steps / 6.0);
-  };
-  SequenceExtrinsicResult result;
-  result.extrinsic = C0;
-  result.time_offset_s = result.joint_time_offset_s = dt0;
-  if (!o.enabled) return result;
-  auto fail = [&](SequenceExtrinsicStatus s, const char* why) {
-    result.status = s;
-    result.reason = why;
-    result.extrinsic = C0;
-    result.time_offset_s = dt0;
-    return result;
-  };
-  if (const char* why = d::input_problem(frames_a, times_a, world_a, frames_b, times_b, C0, dt0, o))
-    return fail(SequenceExtrinsicStatus::invalid_input, why);
-  const d::BaseSubmaps<S> submaps = d::base_submaps(ha, frames_a, times_a, o);
-  if (submaps.planes.empty()) return fail(SequenceExtrinsicStatus::invalid_input, "no submaps");
-  result.targets = submaps.planes.size();
-  done(1);
-  auto problem = d::sequence_problem(submaps, times_a, world_a, frames_b, times_b, dt0, o);
-  done(2);
-  const bool joint = o.estimate_time_offset || o.check_time_offset;
-  d::Solve s = d::solve(problem, C0, dt0, joint, o, result.iterations);
-  if (!s.ok) return fail(SequenceExtrinsicStatus::registration_failed, s.reason);
-  if (joint) d::judge_joint_offset(s, dt0, o, result);
-  done(3);
-  if (o.check_time_offset) d::check_offset(problem, s, dt0, o, result);
-  done(4);
-  if (joint && !result.time_offset_refined) {
-    s = d::solve(problem, C0, dt0, false, o, result.iterations);
-    if (!s.ok) return fail(SequenceExtrinsicStatus::registration_failed, s.reason);
-  }
-  done(5);
-  d::take_solve(s, problem, result);
-  if (const auto c = d::extrinsic_covariance(problem, s, joint && result.time_offset_refined, o)) {
-    result.covariance_6x6 = *c;
-    result.has_covariance = true;
-  }
-  done(6);
-  return result;
+  SequenceStep<S> step(ha, frames_a, times_a, world_a, frames_b, times_b, dt0, o, progress);
+  return step.solve(C0, progress);
 }
 
 }  // namespace hots
