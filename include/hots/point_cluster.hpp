@@ -229,23 +229,35 @@ inline PlaneForms plane_forms(const std::vector<FrameCluster>& frames,
   return out;
 }
 
-/// The Hessian block between two frames (or two mapped variables) from their forms.
+/// A frame's (or a mapped variable's) forms scaled so that the cross term of its Hessian block
+/// with another's is -Z_a Z_b^T: Z = [sqrt(2 / N) e, sqrt(2 / (lambda_1 - lambda_0)) w_1,
+/// sqrt(2 / (lambda_2 - lambda_0)) w_2]. All three coefficients of the header comment's H_ab
+/// are negative, so a plane's cross terms over its variables are one rank-3 update, and each
+/// variable's factor is computed once instead of once per pair. f must not be degenerate.
+inline Eigen::Matrix<double, 6, 3> hessian_factor(const PlaneForms& f,
+                                                  const Eigen::Matrix<double, 6, 3>& w,
+                                                  const Vec6d& e) {
+  Eigen::Matrix<double, 6, 3> Z;
+  Z.col(0) = std::sqrt(2.0 / f.count) * e;
+  for (int k = 1; k < 3; ++k) Z.col(k) = std::sqrt(2.0 / (f.values(k) - f.values(0))) * w.col(k);
+  return Z;
+}
+
+/// H(a, b) -= Za Zb^T and, for a pair of distinct variables (mirror), its transpose at (b, a).
+inline void subtract_cross_terms(Eigen::MatrixXd& H, Eigen::Index a, Eigen::Index b,
+                                 const Eigen::Matrix<double, 6, 3>& Za,
+                                 const Eigen::Matrix<double, 6, 3>& Zb, bool mirror) {
+  const Mat6d block = Za * Zb.transpose();
+  H.block<6, 6>(a, b) -= block;
+  if (mirror) H.block<6, 6>(b, a) -= block.transpose();
+}
+
+/// The Hessian block between two frames (or two mapped variables) from their forms, without
+/// frame a's own second-order term.
 inline Mat6d plane_hessian_block(const PlaneForms& f, const Eigen::Matrix<double, 6, 3>& wa,
                                  const Vec6d& ea, const Eigen::Matrix<double, 6, 3>& wb,
                                  const Vec6d& eb) {
-  Mat6d block = -2.0 * ea * eb.transpose() / f.count;
-  for (int k = 1; k < 3; ++k)
-    block += 2.0 * wa.col(k) * wb.col(k).transpose() / (f.values(0) - f.values(k));
-  return block;
-}
-
-/// H(a, b) += block and, for a pair of distinct variables (mirror), H(b, a) += block^T.
-/// plane_hessian_block(b, a) is plane_hessian_block(a, b)^T to the bit (the same products,
-/// summed in the same order), so a caller summing a plane's blocks visits each pair once.
-inline void add_symmetric_block(Eigen::MatrixXd& H, Eigen::Index a, Eigen::Index b,
-                                const Mat6d& block, bool mirror) {
-  H.block<6, 6>(a, b) += block;
-  if (mirror) H.block<6, 6>(b, a) += block.transpose();
+  return -(hessian_factor(f, wa, ea) * hessian_factor(f, wb, eb).transpose());
 }
 
 /// Cost, gradient and Hessian of one plane (see the header comment and PlaneForms).

@@ -106,8 +106,27 @@ Eigen::Matrix<double, 6, 12> entry_jacobian(const SweepWindow<Cloud>& w,
   return J;
 }
 
+/// Each entry's own second-order block, summed over its planes, through its Jacobian J
+/// (6 x 12, [xi_k; xi_k+1]): J^T own J into the blocks of its variables. The map is linear, so
+/// one product per entry replaces one per plane and entry.
+template <class Cloud>
+void add_entry_own(const SweepWindow<Cloud>& w, std::size_t V,
+                   const std::vector<Eigen::Matrix<double, 6, 12>>& jacobians,
+                   window_ba_detail::Sums& sums) {
+  for (std::size_t e = 0; e < sums.entry_own.size(); ++e) {
+    const std::size_t k = w.sweep[e];
+    const std::size_t sides = k + 1 < V ? 2 : 1;
+    const Eigen::Matrix<double, 12, 12> mapped =
+        jacobians[e].transpose() * sums.entry_own[e] * jacobians[e];
+    const auto at = static_cast<Eigen::Index>(6 * k);
+    const auto n = static_cast<Eigen::Index>(6 * sides);
+    sums.H.block(at, at, n, n) += mapped.topLeftCorner(n, n);
+  }
+}
+
 /// Cost, gradient and Hessian over the variables: each plane's factored forms (PlaneForms) are
-/// mapped through the entries' Jacobians and their outer products summed per variable pair.
+/// mapped through the entries' Jacobians and their outer products summed per variable pair;
+/// the planes' own blocks per entry (add_entry_own).
 template <class Cloud>
 window_ba_detail::Sums evaluate(const std::vector<Plane>& planes, const SweepWindow<Cloud>& w,
                                 const std::vector<Isometry3d>& x, const WindowBaOptions& o) {
@@ -116,46 +135,39 @@ window_ba_detail::Sums evaluate(const std::vector<Plane>& planes, const SweepWin
   std::vector<Eigen::Matrix<double, 6, 12>> jacobians(entries.size());
   for (std::size_t e = 0; e < entries.size(); ++e) jacobians[e] = entry_jacobian(w, x, e);
   const std::size_t V = x.size();
-  window_ba_detail::Sums out = window_ba_detail::sum_planes(
-      planes, entries, V, o,
-      [&](const Plane& plane, const PlaneForms& f, window_ba_detail::Sums& acc) {
-        std::vector<std::size_t> vars;  // the plane's variables, and their mapped forms
-        std::vector<Mat63> W;
-        std::vector<Vec6d> E;
-        for (std::size_t a = 0; a < plane.frames.size(); ++a) {
-          const std::size_t e = plane.frames[a].frame, k = w.sweep[e];
-          const std::size_t sides = k + 1 < V ? 2 : 1;
-          for (std::size_t side = 0; side < sides; ++side) {
-            const auto Ja =
-                jacobians[e].template middleCols<6>(static_cast<Eigen::Index>(6 * side));
-            const std::size_t var = k + side;
-            const auto it = std::find(vars.begin(), vars.end(), var);
-            const std::size_t slot = static_cast<std::size_t>(it - vars.begin());
-            if (it == vars.end()) {
-              vars.push_back(var);
-              W.push_back(Mat63::Zero());
-              E.push_back(Vec6d::Zero());
-            }
-            W[slot] += Ja.transpose() * f.w[a];
-            E[slot] += Ja.transpose() * f.e[a];
-            // The entry's own second-order block, through both of its variables.
-            const auto ia = static_cast<Eigen::Index>(6 * var);
-            for (std::size_t side_b = 0; side_b < sides; ++side_b) {
-              const auto Jb =
-                  jacobians[e].template middleCols<6>(static_cast<Eigen::Index>(6 * side_b));
-              acc.H.template block<6, 6>(ia, static_cast<Eigen::Index>(6 * (k + side_b))) +=
-                  Ja.transpose() * f.own[a] * Jb;
-            }
-          }
+  const auto add_plane = [&](const Plane& plane, const PlaneForms& f, window_ba_detail::Sums& acc) {
+    std::vector<std::size_t> vars;  // the plane's variables, and their mapped forms
+    std::vector<Mat63> W;
+    std::vector<Vec6d> E;
+    for (std::size_t a = 0; a < plane.frames.size(); ++a) {
+      const std::size_t e = plane.frames[a].frame, k = w.sweep[e];
+      acc.entry_own[e] += f.own[a];
+      const std::size_t sides = k + 1 < V ? 2 : 1;
+      for (std::size_t side = 0; side < sides; ++side) {
+        const auto Ja = jacobians[e].template middleCols<6>(static_cast<Eigen::Index>(6 * side));
+        const std::size_t var = k + side;
+        const auto it = std::find(vars.begin(), vars.end(), var);
+        const std::size_t slot = static_cast<std::size_t>(it - vars.begin());
+        if (it == vars.end()) {
+          vars.push_back(var);
+          W.push_back(Mat63::Zero());
+          E.push_back(Vec6d::Zero());
         }
-        for (std::size_t i = 0; i < vars.size(); ++i) {
-          const auto ia = static_cast<Eigen::Index>(6 * vars[i]);
-          acc.g.template segment<6>(ia) += W[i].col(0);
-          for (std::size_t j = i; j < vars.size(); ++j)
-            add_symmetric_block(acc.H, ia, static_cast<Eigen::Index>(6 * vars[j]),
-                                plane_hessian_block(f, W[i], E[i], W[j], E[j]), j != i);
-        }
-      });
+        W[slot] += Ja.transpose() * f.w[a];
+        E[slot] += Ja.transpose() * f.e[a];
+      }
+    }
+    std::vector<Mat63> Z(vars.size());
+    for (std::size_t i = 0; i < vars.size(); ++i) Z[i] = hessian_factor(f, W[i], E[i]);
+    for (std::size_t i = 0; i < vars.size(); ++i) {
+      const auto ia = static_cast<Eigen::Index>(6 * vars[i]);
+      acc.g.template segment<6>(ia) += W[i].col(0);
+      for (std::size_t j = i; j < vars.size(); ++j)
+        subtract_cross_terms(acc.H, ia, static_cast<Eigen::Index>(6 * vars[j]), Z[i], Z[j], j != i);
+    }
+  };
+  window_ba_detail::Sums out = window_ba_detail::sum_planes(planes, entries, V, o, add_plane, true);
+  add_entry_own(w, V, jacobians, out);
   out.H = 0.5 * (out.H + out.H.transpose());
   return out;
 }

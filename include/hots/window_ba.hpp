@@ -75,19 +75,24 @@ struct Sums {
   Eigen::VectorXd g;
   double cost = 0.0;
   std::size_t degenerate = 0;
+  /// Per entry, its planes' own second-order blocks (PlaneForms::own) summed, for a caller
+  /// that maps them through the entry's Jacobian once (sweep_ba.hpp); empty otherwise.
+  std::vector<Mat6d> entry_own;
 };
 
 /// Sums over the planes in fixed chunks (the same bits for any number of threads): each
 /// plane's factored derivatives (PlaneForms) at the entries' poses, its cost and degeneracy
 /// counted here; add_plane(plane, forms, acc) adds its gradient and Hessian to acc (over
-/// `variables` poses).
+/// `variables` poses; with entry_own, Sums::entry_own has one block per entry).
 template <class AddPlane>
 Sums sum_planes(const std::vector<Plane>& planes, const std::vector<Isometry3d>& entry_poses,
-                std::size_t variables, const WindowBaOptions& o, const AddPlane& add_plane) {
+                std::size_t variables, const WindowBaOptions& o, const AddPlane& add_plane,
+                bool entry_own = false) {
   const auto n = static_cast<Eigen::Index>(6 * variables);
   Sums identity;
   identity.H = Eigen::MatrixXd::Zero(n, n);
   identity.g = Eigen::VectorXd::Zero(n);
+  if (entry_own) identity.entry_own.assign(entry_poses.size(), Mat6d::Zero());
   const auto body = [&](std::size_t begin, std::size_t end, Sums acc) {
     for (std::size_t p = begin; p < end; ++p) {
       const PlaneForms f =
@@ -103,6 +108,7 @@ Sums sum_planes(const std::vector<Plane>& planes, const std::vector<Isometry3d>&
   const auto join = [](Sums a, const Sums& b) {
     a.H += b.H;
     a.g += b.g;
+    for (std::size_t e = 0; e < a.entry_own.size(); ++e) a.entry_own[e] += b.entry_own[e];
     a.cost += b.cost;
     a.degenerate += b.degenerate;
     return a;
@@ -114,14 +120,16 @@ inline Sums evaluate(const std::vector<Plane>& planes, const std::vector<Isometr
                      const WindowBaOptions& o) {
   return sum_planes(planes, poses, poses.size(), o,
                     [](const Plane& plane, const PlaneForms& f, Sums& acc) {
-                      for (std::size_t a = 0; a < plane.frames.size(); ++a) {
+                      const std::size_t K = plane.frames.size();
+                      std::vector<Eigen::Matrix<double, 6, 3>> Z(K);
+                      for (std::size_t a = 0; a < K; ++a) Z[a] = hessian_factor(f, f.w[a], f.e[a]);
+                      for (std::size_t a = 0; a < K; ++a) {
                         const auto ia = static_cast<Eigen::Index>(6 * plane.frames[a].frame);
                         acc.g.segment<6>(ia) += f.w[a].col(0);
-                        for (std::size_t b = a; b < plane.frames.size(); ++b) {
-                          Mat6d block = plane_hessian_block(f, f.w[a], f.e[a], f.w[b], f.e[b]);
-                          if (a == b) block += f.own[a];
+                        acc.H.block<6, 6>(ia, ia) += f.own[a];
+                        for (std::size_t b = a; b < K; ++b) {
                           const auto ib = static_cast<Eigen::Index>(6 * plane.frames[b].frame);
-                          add_symmetric_block(acc.H, ia, ib, block, b != a);
+                          subtract_cross_terms(acc.H, ia, ib, Z[a], Z[b], b != a);
                         }
                       }
                     });
