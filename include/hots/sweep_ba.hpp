@@ -18,8 +18,11 @@
 //     Hessian with respect to the entries' left perturbations are mapped to the variables'
 //     by the chain rule, zeta_e = J_e [xi_k; xi_k+1] (J_e by central differences of
 //     log(E_e(xi) E_e^-1): the map is smooth and 12 evaluations per entry cost nothing beside
-//     the planes), plane by plane on the factored forms (PlaneForms), so a plane costs
-//     O(entries) rather than O(entries^2); the Hessian is J^T H J (the map's second
+//     the planes), plane by plane on the factored forms (PlaneForms): a plane's cross terms are
+//     one rank-3 update over its variables (hessian_factor), and its entries' own second-order
+//     blocks are summed per entry over all planes and mapped through J_e once (the map is
+//     linear: one 12 x 12 product per entry instead of one per plane and entry;
+//     docs/experiments/sixty_second_drive_speed.md). The Hessian is J^T H J (the map's second
 //     derivative is left out, as in Gauss-Newton: it only shapes the steps, and LM accepts a
 //     step on the true cost).
 //   - The result is a WindowBaResult over the V variables (hessian 6V x 6V, window frame) and

@@ -128,6 +128,48 @@ TEST_CASE("sweep BA: the knots' gradient is the cost's derivative", "[hots][swee
   }
 }
 
+TEST_CASE("sweep BA: the knots' Hessian is the planes' Hessians through the entries' Jacobians",
+          "[hots][sweep_ba]") {
+  // The reference: each plane's dense Hessian over its entries (evaluate_plane, itself checked
+  // against central differences in test_point_cluster) mapped by J_e into the knots, term by
+  // term. evaluate() sums the same from factors and per-entry blocks.
+  using namespace sweep_test;
+  const Sweeps& s = sweeps();
+  const SweepWindow<Cloud> w = s.window();
+  std::vector<Isometry3d> x = s.odometry;
+  for (auto& T : x) T = s.odometry[0].inverse() * T;
+  WindowBaOptions options;
+  const auto entries = sweep_ba_detail::entry_poses(w, x);
+  const auto planes = extract_planes(w.clouds, entries, options.planes);
+  REQUIRE(planes.size() > 50);
+  const auto n = static_cast<Eigen::Index>(6 * x.size());
+  std::vector<Eigen::MatrixXd> to_knots;  // per entry: 6 x 6V, J_e placed at its knots
+  for (std::size_t e = 0; e < entries.size(); ++e) {
+    Eigen::MatrixXd J = Eigen::MatrixXd::Zero(6, n);
+    const auto Je = sweep_ba_detail::entry_jacobian(w, x, e);
+    const auto at = static_cast<Eigen::Index>(6 * w.sweep[e]);
+    const Eigen::Index cols = std::min<Eigen::Index>(12, n - at);
+    J.middleCols(at, cols) = Je.leftCols(cols);
+    to_knots.push_back(J);
+  }
+  Eigen::MatrixXd reference = Eigen::MatrixXd::Zero(n, n);
+  for (const Plane& plane : planes) {
+    const PlaneDerivatives d =
+        evaluate_plane(plane.frames, entries, plane.anchor, options.evaluation);
+    if (d.degenerate) continue;
+    for (std::size_t a = 0; a < plane.frames.size(); ++a)
+      for (std::size_t b = 0; b < plane.frames.size(); ++b)
+        reference += to_knots[plane.frames[a].frame].transpose() *
+                     d.hessian.block<6, 6>(static_cast<Eigen::Index>(6 * a),
+                                           static_cast<Eigen::Index>(6 * b)) *
+                     to_knots[plane.frames[b].frame];
+  }
+  reference = 0.5 * (reference + reference.transpose());
+  const auto sums = sweep_ba_detail::evaluate(planes, w, x, options);
+  CHECK((sums.H - reference).norm() <= 1e-9 * reference.norm());
+  CHECK(reference.norm() > 0.0);
+}
+
 TEST_CASE("sweep BA recovers knots from sweeps deskewed with a wrong motion", "[hots][sweep_ba]") {
   using namespace sweep_test;
   const Sweeps& s = sweeps();

@@ -93,6 +93,35 @@ TEMPLATE_TEST_CASE("window BA brings perturbed poses back to the truth", "[hots]
   CHECK(eig.eigenvalues()(0) > 0.0);
 }
 
+TEST_CASE("window BA's Hessian is the sum of the planes' Hessians", "[hots][window_ba]") {
+  // evaluate() sums each plane's cross terms as a rank-3 update and its own blocks apart; the
+  // reference places evaluate_plane's dense Hessian (checked against central differences in
+  // test_point_cluster) at the frames' blocks.
+  const Window& w = window();
+  const std::vector<Isometry3d> poses = disturbed(w.truth, 5);
+  WindowBaOptions options;
+  std::vector<const std::vector<Vec3d>*> clouds;
+  for (const auto& f : w.frames) clouds.push_back(&f);
+  const auto planes = extract_planes(clouds, poses, options.planes);
+  REQUIRE(planes.size() > 20);
+  const auto n = static_cast<Eigen::Index>(6 * poses.size());
+  Eigen::MatrixXd reference = Eigen::MatrixXd::Zero(n, n);
+  for (const Plane& plane : planes) {
+    const PlaneDerivatives d =
+        evaluate_plane(plane.frames, poses, plane.anchor, options.evaluation);
+    if (d.degenerate) continue;
+    for (std::size_t a = 0; a < plane.frames.size(); ++a)
+      for (std::size_t b = 0; b < plane.frames.size(); ++b)
+        reference.block<6, 6>(static_cast<Eigen::Index>(6 * plane.frames[a].frame),
+                              static_cast<Eigen::Index>(6 * plane.frames[b].frame)) +=
+            d.hessian.block<6, 6>(static_cast<Eigen::Index>(6 * a),
+                                  static_cast<Eigen::Index>(6 * b));
+  }
+  const auto sums = window_ba_detail::evaluate(planes, poses, options);
+  CHECK((sums.H - reference).norm() <= 1e-9 * reference.norm());
+  CHECK(reference.norm() > 0.0);
+}
+
 TEST_CASE("window BA gives the same bits on 1 and 2 threads", "[hots][window_ba]") {
   const Window& w = window();
   const auto start = disturbed(w.truth, 8);
