@@ -7,6 +7,7 @@
 #include <random>
 #include <vector>
 
+#include "assembled_hessian.hpp"
 #include "hots/sweep_ba.hpp"
 #include "hots/window_ba.hpp"
 #include "hots_test_util.hpp"
@@ -152,19 +153,8 @@ TEST_CASE("sweep BA: the knots' Hessian is the planes' Hessians through the entr
     J.middleCols(at, cols) = Je.leftCols(cols);
     to_knots.push_back(J);
   }
-  Eigen::MatrixXd reference = Eigen::MatrixXd::Zero(n, n);
-  for (const Plane& plane : planes) {
-    const PlaneDerivatives d =
-        evaluate_plane(plane.frames, entries, plane.anchor, options.evaluation);
-    if (d.degenerate) continue;
-    for (std::size_t a = 0; a < plane.frames.size(); ++a)
-      for (std::size_t b = 0; b < plane.frames.size(); ++b)
-        reference += to_knots[plane.frames[a].frame].transpose() *
-                     d.hessian.block<6, 6>(static_cast<Eigen::Index>(6 * a),
-                                           static_cast<Eigen::Index>(6 * b)) *
-                     to_knots[plane.frames[b].frame];
-  }
-  reference = 0.5 * (reference + reference.transpose());
+  const Eigen::MatrixXd reference =
+      hots_test::assembled_hessian(planes, entries, options.evaluation, to_knots);
   const auto sums = sweep_ba_detail::evaluate(planes, w, x, options);
   CHECK((sums.H - reference).norm() <= 1e-9 * reference.norm());
   CHECK(reference.norm() > 0.0);

@@ -5,6 +5,7 @@
 #include <random>
 #include <vector>
 
+#include "assembled_hessian.hpp"
 #include "hots/window_ba.hpp"
 #include "hots_test_util.hpp"
 #include "ulc/core/pose_error.hpp"
@@ -105,18 +106,12 @@ TEST_CASE("window BA's Hessian is the sum of the planes' Hessians", "[hots][wind
   const auto planes = extract_planes(clouds, poses, options.planes);
   REQUIRE(planes.size() > 20);
   const auto n = static_cast<Eigen::Index>(6 * poses.size());
-  Eigen::MatrixXd reference = Eigen::MatrixXd::Zero(n, n);
-  for (const Plane& plane : planes) {
-    const PlaneDerivatives d =
-        evaluate_plane(plane.frames, poses, plane.anchor, options.evaluation);
-    if (d.degenerate) continue;
-    for (std::size_t a = 0; a < plane.frames.size(); ++a)
-      for (std::size_t b = 0; b < plane.frames.size(); ++b)
-        reference.block<6, 6>(static_cast<Eigen::Index>(6 * plane.frames[a].frame),
-                              static_cast<Eigen::Index>(6 * plane.frames[b].frame)) +=
-            d.hessian.block<6, 6>(static_cast<Eigen::Index>(6 * a),
-                                  static_cast<Eigen::Index>(6 * b));
+  std::vector<Eigen::MatrixXd> to_frames;  // frame f's block of the variables
+  for (std::size_t f = 0; f < poses.size(); ++f) {
+    to_frames.push_back(Eigen::MatrixXd::Zero(6, n));
+    to_frames.back().middleCols<6>(static_cast<Eigen::Index>(6 * f)).setIdentity();
   }
+  const Eigen::MatrixXd reference = assembled_hessian(planes, poses, options.evaluation, to_frames);
   const auto sums = window_ba_detail::evaluate(planes, poses, options);
   CHECK((sums.H - reference).norm() <= 1e-9 * reference.norm());
   CHECK(reference.norm() > 0.0);
