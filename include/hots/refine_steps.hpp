@@ -546,7 +546,7 @@ bool sequence_step(RefineState<S>& s, const RefineOptions& options, RefineResult
   // Without synchronisation the offset is the caller's (known clocks): nothing to check.
   so.check_time_offset = so.check_time_offset && options.synchronise_time;
   const auto t0 = std::chrono::steady_clock::now();
-  const std::vector<Isometry3d> world_a = graph_poses(s, s.a);
+  const std::vector<Isometry3d> world_a = graph_poses(s, s.a);  // read by the step and its rerun
   SequenceStep<S> step(s.a.hierarchy, s.a.frames, s.a.times, world_a, s.b.frames, s.b.times,
                        result.time_offset_s, so, progress);
   st.sequence = step.solve(result.extrinsic, progress);

@@ -477,6 +477,7 @@ struct Solve {
   Isometry3d C = Isometry3d::Identity();
   double dt = 0.0;
   JointSums sums;
+  std::size_t frames = 0, source_points = 0;  ///< the terms the final sums ran over
 };
 
 template <typename S>
@@ -499,6 +500,8 @@ Solve solve(SequenceProblem<S>& problem, const Isometry3d& C, double dt, bool wi
   }
   problem.set_stage(o.stages.back(), with_time);
   out.sums = problem.final_sums(x);
+  out.frames = problem.terms().size();
+  for (const auto& t : problem.terms()) out.source_points += t.size;
   if (out.sums.count < o.stages.back().min_correspondences) {
     out.reason = kStarved;
     return out;
@@ -515,13 +518,13 @@ const char* input_problem(const std::vector<std::vector<ulc::Vec3<S>>>& frames_a
                           const std::vector<double>& times_a,
                           const std::vector<Isometry3d>& world_a,
                           const std::vector<std::vector<ulc::Vec3<S>>>& frames_b,
-                          const std::vector<double>& times_b, const Isometry3d& C0, double dt0,
+                          const std::vector<double>& times_b, double dt0,
                           const SequenceExtrinsicOptions& o) {
   if (times_a.size() < 2 || world_a.size() != times_a.size() || frames_a.size() != times_a.size() ||
       frames_b.size() != times_b.size() || o.stages.empty() || !(o.source_voxel >= 0.0) ||
       !(o.target_voxel >= 0.0) || !(o.time_window_s >= 0.0) || !(o.derivative_step_s > 0.0) ||
       !(o.min_condition >= 0.0) || !(o.max_time_disagreement_s >= 0.0) ||
-      !(o.min_time_observability >= 0.0) || !C0.matrix().allFinite() || !std::isfinite(dt0))
+      !(o.min_time_observability >= 0.0) || !std::isfinite(dt0))
     return "bad inputs or options";
   for (const auto& stage : o.stages)
     if (stage.max_iterations < 1 || stage.max_solver_iterations < 1 ||
@@ -563,7 +566,6 @@ void check_offset(SequenceProblem<S>& problem, const Solve& s, double dt0,
       result.half_time_offset_s[h] = half.ok ? half.dt : s.dt;
     }
     problem.set_span(0, n);
-    problem.match({s.C, s.dt});  // the whole drive's terms again, for the result's statistics
     if (!halves_ok)
       result.time_offset_doubt = "a half of the drive could not be registered on its own";
     else if (std::abs(result.half_time_offset_s[0] - result.half_time_offset_s[1]) >
@@ -600,14 +602,12 @@ std::optional<Mat6d> extrinsic_covariance(SequenceProblem<S>& problem, const Sol
 }
 
 /// The solve's answer and statistics into the result.
-template <typename S>
-void take_solve(const Solve& s, const SequenceProblem<S>& problem,
-                SequenceExtrinsicResult& result) {
+inline void take_solve(const Solve& s, SequenceExtrinsicResult& result) {
   result.status = SequenceExtrinsicStatus::ok;
   result.extrinsic = s.C;
   result.time_offset_s = s.dt;
-  result.frames = problem.terms().size();
-  for (const auto& t : problem.terms()) result.source_points += t.size;
+  result.frames = s.frames;
+  result.source_points = s.source_points;
   result.correspondences = s.sums.count;
   result.inliers = s.sums.inliers;
   result.rmse = s.sums.rmse();
@@ -640,9 +640,7 @@ class SequenceStep {
       : o_(o), dt0_(dt0) {
     namespace d = sequence_detail;
     if (!o.enabled) return;
-    const Isometry3d any_start = Isometry3d::Identity();
-    input_error_ =
-        d::input_problem(frames_a, times_a, world_a, frames_b, times_b, any_start, dt0, o);
+    input_error_ = d::input_problem(frames_a, times_a, world_a, frames_b, times_b, dt0, o);
     if (input_error_) return;
     submaps_ = d::base_submaps(ha, frames_a, times_a, o);
     if (submaps_.planes.empty()) {
@@ -684,7 +682,7 @@ class SequenceStep {
       return result;
     };
     if (!C0.matrix().allFinite())
-      return fail(SequenceExtrinsicStatus::invalid_input, "bad inputs or options");
+      return fail(SequenceExtrinsicStatus::invalid_input, "the start extrinsic is not finite");
     if (input_error_) return fail(SequenceExtrinsicStatus::invalid_input, input_error_);
     result.targets = submaps_.planes.size();
     auto& problem = *problem_;
@@ -700,7 +698,7 @@ class SequenceStep {
       if (!s.ok) return fail(SequenceExtrinsicStatus::registration_failed, s.reason);
     }
     done(5);
-    d::take_solve(s, problem, result);
+    d::take_solve(s, result);
     if (!full) return result;
     if (const auto c =
             d::extrinsic_covariance(problem, s, joint && result.time_offset_refined, o_)) {

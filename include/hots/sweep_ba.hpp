@@ -160,14 +160,15 @@ window_ba_detail::Sums evaluate(const std::vector<Plane>& planes, const SweepWin
         E[slot] += Ja.transpose() * f.e[a];
       }
     }
-    std::vector<Mat63> Z(vars.size());
-    for (std::size_t i = 0; i < vars.size(); ++i) Z[i] = hessian_factor(f, W[i], E[i]);
+    // The gradient from the mapped forms, then each variable's forms become its Hessian factor.
     for (std::size_t i = 0; i < vars.size(); ++i) {
-      const auto ia = static_cast<Eigen::Index>(6 * vars[i]);
-      acc.g.template segment<6>(ia) += W[i].col(0);
-      for (std::size_t j = i; j < vars.size(); ++j)
-        subtract_cross_terms(acc.H, ia, static_cast<Eigen::Index>(6 * vars[j]), Z[i], Z[j], j != i);
+      acc.g.template segment<6>(static_cast<Eigen::Index>(6 * vars[i])) += W[i].col(0);
+      W[i] = hessian_factor(f, W[i], E[i]);
     }
+    for (std::size_t i = 0; i < vars.size(); ++i)
+      for (std::size_t j = i; j < vars.size(); ++j)
+        subtract_cross_terms(acc.H, static_cast<Eigen::Index>(6 * vars[i]),
+                             static_cast<Eigen::Index>(6 * vars[j]), W[i], W[j], j != i);
   };
   window_ba_detail::Sums out = window_ba_detail::sum_planes(planes, entries, V, o, add_plane, true);
   add_entry_own(w, V, jacobians, out);
