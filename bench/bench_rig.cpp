@@ -4,13 +4,16 @@
 //
 //   bench_rig [--scenarios ring-5x16,pitched-90,side-bpearl] [--seconds 10]
 //             [--stages terra,jeep,hots] [--decimation 1] [--seed 1] [--threads 2]
-//             [--no-route] [--no-cycles] [--synced-clocks] [--base-odometry] [--no-motion]
+//             [--no-route] [--no-cycles] [--synced-clocks] [--base-odometry | --joint-odometry]
+//             [--no-motion]
 //             [--json]
 // --synced-clocks: the pairs are told their clocks agree (the simulated rigs' do), so HOTS
 // neither estimates nor checks an offset; without it, a drive too short to pin the offset down
-// fails with time_offset_untrusted. --base-odometry: HOTS starts from the base's own odometry,
-// run once for every target. --no-motion: TERRA's motion frame off (map_terra_options.hpp).
-// On stderr, per target: each stage's seconds and the TERRA hypotheses tried.
+// fails with time_offset_untrusted. --base-odometry / --joint-odometry: HOTS starts from the
+// base's own odometry, run once for every target, or from both LiDARs' (default: the pipeline
+// chooses, pipeline/odometry_choice.hpp). --no-motion: TERRA's motion frame off
+// (map_terra_options.hpp). On stderr, per target: each stage's seconds and the TERRA hypotheses
+// tried.
 //
 // Per target: e_rot (deg) and e_trans (cm) against the simulator's mounts, the calibration's
 // status, the route, the clock offset error when HOTS ran, the cross links of the kept result
@@ -47,8 +50,8 @@ struct Config {
   bool route = true;
   bool cycles = true;
   bool synced_clocks = false;  ///< --synced-clocks: no clock offset estimated (the rigs share one)
-  bool base_odometry = false;  ///< --base-odometry: HOTS from the base's own odometry, run once
-  bool motion = true;          ///< --no-motion: TERRA's motion frame off
+  ulc::HotsOdometry odometry = ulc::HotsOdometry::automatic;  ///< --base-/--joint-odometry
+  bool motion = true;  ///< --no-motion: TERRA's motion frame off
   ulc_bench::Options bench;
 };
 
@@ -107,7 +110,7 @@ void bench(const Config& c) {
     ulc::RigOptions o;
     o.pair.stages = stages.stages;
     if (c.synced_clocks) o.pair.time_offset_s = 0.0;
-    if (c.base_odometry) o.pair.tuning.hots_odometry = ulc::HotsOdometry::base;
+    o.pair.tuning.hots_odometry = c.odometry;
     o.pair.tuning.terra_source.maps.motion.enabled = c.motion;
     o.route = c.route;
     o.cycles = c.cycles;
@@ -217,8 +220,13 @@ int main(int argc, char** argv) {
   app.add_flag_callback(
       "--no-cycles", [&] { c.cycles = false; }, "no cycle checks");
   app.add_flag("--synced-clocks", c.synced_clocks, "the pairs' clocks agree: no offset estimated");
-  app.add_flag("--base-odometry", c.base_odometry,
-               "HOTS starts from the base's own odometry, run once for every target");
+  auto* base = app.add_flag_callback(
+      "--base-odometry", [&] { c.odometry = ulc::HotsOdometry::base; },
+      "HOTS starts from the base's own odometry, run once for every target");
+  app.add_flag_callback(
+         "--joint-odometry", [&] { c.odometry = ulc::HotsOdometry::joint; },
+         "HOTS starts from the odometry of both LiDARs")
+      ->excludes(base);
   app.add_flag_callback(
       "--no-motion", [&] { c.motion = false; }, "TERRA's motion frame off");
   CLI11_PARSE(app, argc, argv);

@@ -211,8 +211,9 @@ target= calibrates a pair and returns a Result; targets=[...] (with target_times
 and returns a RigResult. The other keywords mirror `ulc calibrate --help`: stages, initial
 (text as --initial, or 4x4 arrays), frame_index, frames, synced_clocks, time_offset, threads,
 route (not --no-route), cycles (not --no-cycles), start, duration, frame_time, budget (paths:
-seconds HOTS calibrates on, a longer drive's best stretch chosen; 0: all), base_odometry (as
---base-odometry: HOTS starts from the base's own odometry, run once for every target); names gives each
+seconds HOTS calibrates on, a longer drive's best stretch chosen; 0: all), base_odometry (True as
+--base-odometry: HOTS starts from the base's own odometry, run once for every target; False as
+--joint-odometry; None: the pipeline chooses, as the command line does); names gives each
 LiDAR's name (base first). progress(stage, fraction) is called between steps. Bad input raises
 ulc.Error with the command line's message; Ctrl-C raises KeyboardInterrupt.)";
 
@@ -257,13 +258,15 @@ void bind_calibrate(py::module_& m) {
          const py::object& initial, std::size_t frame_index, std::size_t frames, bool synced_clocks,
          std::optional<double> time_offset, std::size_t threads, bool route, bool cycles,
          std::optional<double> start, std::optional<double> duration, const std::string& frame_time,
-         double budget, bool base_odometry, const py::object& names, const py::object& progress) {
+         double budget, std::optional<bool> base_odometry, const py::object& names,
+         const py::object& progress) {
         CalibrateKeywords k;
         k.choices.stages = stages_text(stages);
         k.choices.frames = frames;
         k.choices.synced_clocks = synced_clocks;
         k.choices.time_offset_s = time_offset;
-        k.choices.base_odometry = base_odometry;
+        if (base_odometry)
+          k.choices.odometry = *base_odometry ? HotsOdometry::base : HotsOdometry::joint;
         k.initial = initial;
         k.frame_index = frame_index;
         k.threads = threads;
@@ -286,7 +289,7 @@ void bind_calibrate(py::module_& m) {
       py::arg("time_offset") = py::none(), py::arg("threads") = 0, py::arg("route") = true,
       py::arg("cycles") = true, py::arg("start") = py::none(), py::arg("duration") = py::none(),
       py::arg("frame_time") = "header", py::arg("budget") = SelectionOptions{}.budget_s,
-      py::arg("base_odometry") = false, py::arg("names") = py::none(),
+      py::arg("base_odometry") = py::none(), py::arg("names") = py::none(),
       py::arg("progress") = py::none());
 }
 

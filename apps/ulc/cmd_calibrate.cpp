@@ -122,7 +122,7 @@ struct CalibrateArgs {
   long long frame_index = 0, frames = static_cast<long long>(jeep::JeepOptions{}.frames),
             threads = 0;
   bool synced_clocks = false, no_route = false, no_cycles = false, quiet = false,
-       base_odometry = false;
+       base_odometry = false, joint_odometry = false;
   InputArgs input;
   // Set when the user gave them.
   CLI::Option *output_option = nullptr, *merged_option = nullptr, *report_option = nullptr,
@@ -202,11 +202,14 @@ void add_stage_options(CLI::App& app, CalibrateArgs& a) {
              "no offset is estimated or checked")
           ->type_name("S")
           ->excludes("--synced-clocks");
-  app.add_flag(
-      "--base-odometry", a.base_odometry,
-      "HOTS starts from the base LiDAR's own odometry; it and HOTS's work on the base are done "
-      "once for every target (faster "
-      "for rigs with a 360-degree base; docs/pipeline.md, \"The odometry\")");
+  app.add_flag("--base-odometry", a.base_odometry,
+               "HOTS starts from the base LiDAR's own odometry; it and HOTS's work on the base "
+               "are done once for every target (the default on drives of 30 s or more whose "
+               "base sees all around; docs/pipeline.md, \"The odometry\")");
+  app.add_flag("--joint-odometry", a.joint_odometry,
+               "HOTS starts from the odometry of both LiDARs, run for every hypothesis and "
+               "target (the default on shorter drives or with a narrow base)")
+      ->excludes("--base-odometry");
   app.add_flag("--no-route", a.no_route,
                "do not calibrate a failed target through another target that did calibrate");
   app.add_flag("--no-cycles", a.no_cycles,
@@ -221,7 +224,8 @@ CalibrateOptions calibrate_options(const CalibrateArgs& a) {
   c.synced_clocks = a.synced_clocks;
   if (a.has(a.time_offset_option)) c.time_offset_s = a.time_offset;
   c.frames = static_cast<std::size_t>(a.frames);
-  c.base_odometry = a.base_odometry;
+  if (a.base_odometry) c.odometry = HotsOdometry::base;
+  if (a.joint_odometry) c.odometry = HotsOdometry::joint;
   const CalibrateOptions options = calibrate_options(c);
   for (const CLI::Option* file_option : {a.output_option, a.merged_option, a.report_option})
     if (a.has(file_option)) require_output_folder(file_option->as<std::string>());

@@ -131,7 +131,7 @@ CalibrateOptions calibrate_options(const CalibrateChoices& c) {
   }
   if (c.frames < 1) throw UsageError("calibrate: option '--frames' must be at least 1");
   options.tuning.jeep.frames = c.frames;
-  if (c.base_odometry) options.tuning.hots_odometry = HotsOdometry::base;
+  options.tuning.hots_odometry = c.odometry;
   if (!run_terra) (void)parse_initial(*c.initial, "", "");  // fail before any loading
   return options;
 }

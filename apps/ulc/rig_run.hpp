@@ -26,7 +26,7 @@ struct CalibrateChoices {
   bool synced_clocks = false;                       ///< --synced-clocks
   std::optional<double> time_offset_s;              ///< --time-offset, within [-1, 1] s
   std::size_t frames = jeep::JeepOptions{}.frames;  ///< --frames
-  bool base_odometry = false;                       ///< --base-odometry
+  HotsOdometry odometry = HotsOdometry::automatic;  ///< --base-odometry, --joint-odometry
 };
 
 /// The pipeline's options; UsageError (worded as the command line's) before any frame is read.

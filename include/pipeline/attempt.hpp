@@ -30,6 +30,7 @@
 #include "jeep/jeep.hpp"
 #include "odometry/run_odometry.hpp"
 #include "pipeline/observability_verdict.hpp"
+#include "pipeline/odometry_choice.hpp"
 #include "pipeline/options.hpp"
 #include "pipeline/pair_calibration.hpp"
 #include "ulc/core/frame_range.hpp"
@@ -55,6 +56,8 @@ struct AttemptInputs {
   /// (CalibrateOptions::base_work), else filled by the first attempt that runs HOTS and reused
   /// by every later one, since it depends on neither the target nor the extrinsic.
   mutable BaseWork base;
+  /// Which odometry HOTS starts from: StageTuning::hots_odometry resolved (odometry_choice.hpp).
+  OdometryChoice odometry;
   /// HOTS runs, on a moving rig: it can judge a start.
   bool can_verify() const { return run_hots && frames_left() >= options.tuning.hots_min_frames; }
   std::size_t frames_left() const { return std::min(a.size(), b.size()); }
@@ -255,14 +258,14 @@ inline std::string odometry_doubt(const HotsReport& h, const StageTuning& tuning
          "read from it, are not observed along that direction";
 }
 
-/// HOTS's starting poses from the extrinsic C (StageTuning::hots_odometry): the base's own
+/// HOTS's starting poses from the extrinsic C (in.odometry): the base's own
 /// odometry carried to the target (run once per call, or given by the caller), or the joint one.
 template <class FA, class FB>
 odometry::OdometryResult hots_odometry(const AttemptInputs<FA, FB>& in, const Isometry3d& C,
                                        const std::string& stage) {
   const StageTuning& tuning = in.options.tuning;
   const odometry::ProgressFn progress = count_progress(in.options, stage);
-  if (tuning.hots_odometry == HotsOdometry::joint)
+  if (in.odometry.odometry != HotsOdometry::base)
     return odometry::run_odometry(in.a.frames, in.a.times, in.b.frames, in.b.times, C,
                                   tuning.odometry, progress);
   if (!in.base.odometry)
@@ -278,12 +281,14 @@ StageOutcome hots_step(const AttemptInputs<FA, FB>& in, Attempt& at) {
   const std::string odometry_stage = "odometry" + at.label, hots_stage = "hots" + at.label;
   auto t0 = std::chrono::steady_clock::now();
   notify(in.options, odometry_stage, 0.0);
-  const bool base_only = in.options.tuning.hots_odometry == HotsOdometry::base;
+  const bool base_only = in.odometry.odometry == HotsOdometry::base;
   const bool odometry_reused = base_only && in.base.odometry != nullptr;
   const odometry::OdometryResult odo = hots_odometry(in, at.extrinsic, odometry_stage);
   at.out.timing_s.odometry = seconds_since(t0);
   at.out.hots = odometry_report(odo, at.extrinsic, at.out.timing_s.odometry);
   at.out.hots->odometry_reused = odometry_reused;
+  at.out.hots->odometry = in.odometry.odometry;
+  at.out.hots->odometry_choice = in.odometry.why;
   if (at.out.hots->run == HotsRun::odometry_failed)
     return failed_after_jeep(
         at, CalibrateStatus::hots_failed,

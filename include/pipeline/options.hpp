@@ -18,6 +18,7 @@
 #include "odometry/options.hpp"
 #include "pipeline/hypothesis_options.hpp"
 #include "pipeline/map_terra_options.hpp"
+#include "pipeline/odometry_choice_options.hpp"
 #include "pipeline/stages.hpp"
 #include "pipeline/vouch_options.hpp"
 #include "terra/search_params.hpp"
@@ -41,12 +42,27 @@ enum class HotsOdometry {
   /// The base LiDAR's own odometry, carried to the target through the extrinsic
   /// (odometry::with_target_poses). It depends neither on the target nor on the extrinsic, so
   /// one run serves every TERRA hypothesis of a call and every target of a rig (rig.hpp): 8.3 s
-  /// against the joint one's 21.8 s on the 60 s 64-32 drive, the same extrinsic. Not the
-  /// default: where the target's scans steady the poses (a Horizon base, an Avia target) HOTS
+  /// against the joint one's 21.8 s on the 60 s 64-32 drive, the same extrinsic. Where the
+  /// target's scans steady the poses (a Horizon base; an Avia target on a 10 s drive) HOTS
   /// agrees with fewer cross links and its covariance grows
   /// (docs/experiments/hots_base_odometry.md).
   base,
+  /// The pipeline chooses (pipeline/odometry_choice.hpp): base on a drive of at least
+  /// StageTuning::odometry_choice.min_span_s whose base sees all around, joint otherwise. The
+  /// default.
+  automatic,
 };
+
+inline const char* to_string(HotsOdometry o) {
+  switch (o) {
+    case HotsOdometry::base:
+      return "base";
+    case HotsOdometry::automatic:
+      return "automatic";
+    default:
+      return "joint";
+  }
+}
 
 /// What a call did for the base LiDAR alone (StageTuning::hots_odometry base), for another call
 /// on the same base frames from the same frame_index with the same tuning: a rig's targets share
@@ -70,8 +86,9 @@ struct StageTuning {
   HypothesisOptions hypotheses;     ///< TERRA's later optima tried in turn (not in the paper)
   jeep::JeepOptions jeep;           ///< K = 5 frame pairs, at most 10 rounds
   odometry::OdometryOptions odometry;  ///< the odometry over all frames that feeds HOTS
-  HotsOdometry hots_odometry = HotsOdometry::joint;  ///< which LiDARs that odometry registers
-  hots::RefineOptions hots;  ///< windows of 5, 3 layers, time synchronisation on
+  HotsOdometry hots_odometry = HotsOdometry::automatic;  ///< which LiDARs it registers
+  OdometryChoiceOptions odometry_choice;  ///< hots_odometry automatic: the rule's thresholds
+  hots::RefineOptions hots;               ///< windows of 5, 3 layers, time synchronisation on
   /// Single frames or a static rig (fewer frames than this per LiDAR from frame_index): HOTS
   /// has no motion to work with, so after TERRA or JEEP it is skipped (stages.hots says so) and
   /// their extrinsic is the answer; as the only stage it fails.

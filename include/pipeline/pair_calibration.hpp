@@ -192,6 +192,10 @@ struct HotsReport {
   /// when that step ran.
   std::optional<Observability> observability;
   double odometry_seconds = 0.0;
+  /// Which odometry gave HOTS its poses (StageTuning::hots_odometry resolved: joint or base),
+  /// and why (pipeline/odometry_choice.hpp).
+  HotsOdometry odometry = HotsOdometry::joint;
+  std::string odometry_choice;
   /// The base's own odometry was run before this attempt (by the caller, as a rig does for its
   /// targets, or for an earlier TERRA hypothesis) and reused: odometry_seconds leaves it out.
   bool odometry_reused = false;

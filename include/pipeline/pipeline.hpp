@@ -22,9 +22,11 @@
 //     the previous stage's extrinsic, or from `initial` when it is the first, which is then
 //     required (status initial_required without it).
 //   - HOTS: multi-LiDAR odometry (tuning.odometry) over ALL frames of each LiDAR from frame i
-//     on, with the extrinsic HOTS starts from (or, with tuning.hots_odometry base, the base's own
-//     odometry, run once per call or given as options.base_work, and the target's poses
-//     through that extrinsic; result.base_work hands it on), then hots::refine (tuning.hots) on
+//     on, with the extrinsic HOTS starts from (or the base's own odometry, run once per call or
+//     given as options.base_work, and the target's poses through that extrinsic;
+//     result.base_work hands it on: tuning.hots_odometry base, or automatic on a long drive of
+//     an all-around base, odometry_choice.hpp, with the stages run again on the joint odometry
+//     when that ends without a success), then hots::refine (tuning.hots) on
 //     those frames and poses. Its extrinsic, clock offset and covariance become the result's. An
 //     odometry that could not register some frames still feeds HOTS (its poses are predictions
 //     there; the report counts them); an odometry that gives no poses, or a HOTS that fails, ends
@@ -67,6 +69,7 @@
 #include <tbb/task_arena.h>
 
 #include "pipeline/attempt.hpp"
+#include "pipeline/odometry_choice.hpp"
 #include "pipeline/options.hpp"
 #include "pipeline/pair_calibration.hpp"
 #include "pipeline/point_times.hpp"
@@ -264,6 +267,17 @@ StageOutcome vouch_read(const AttemptInputs<FA, FB>& in, PairCalibration& r) {
   return vouch(in, r);
 }
 
+/// StageTuning::hots_odometry resolved on the base's frames from frame_index, when HOTS is
+/// asked for (odometry_choice.hpp); joint otherwise (no odometry runs).
+template <class FA>
+OdometryChoice hots_odometry_choice(const FA& frames_a, const std::vector<double>& times_a,
+                                    const CalibrateOptions& options) {
+  const std::size_t i = options.frame_index;
+  if (!has_stage(options.stages, Stage::hots)) return {};
+  return choose_odometry(options.tuning.hots_odometry, FrameRange<FA>(frames_a, i),
+                         times_from(times_a, i), options.tuning.odometry_choice);
+}
+
 /// TERRA alone: its best rotation is the answer.
 inline PairCalibration terra_only(const StartRotations& starts, PairCalibration& r,
                                   const Finish& finish) {
@@ -272,6 +286,39 @@ inline PairCalibration terra_only(const StartRotations& starts, PairCalibration&
       hypothesis_entry(starts.candidates.front(), starts.sources.front()));
   r.terra->hypotheses.back().motion = starts.motion_first;
   return finish(CalibrateStatus::ok, "");
+}
+
+/// The stages after TERRA (from `starts`, or from options.initial without TERRA), then the
+/// vouching: the call's result.
+template <class FA, class FB>
+PairCalibration attempts_vouched(const AttemptInputs<FA, FB>& in, const StartRotations* starts,
+                                 PairCalibration& r, const Finish& finish) {
+  if (starts) {
+    try_hypotheses(in, *starts, r, finish);
+  } else {
+    r.T_base_target = *in.options.initial;
+    const StageOutcome o = run_attempt(in, *in.options.initial, "", true, r);
+    finish(o.status, o.reason);
+  }
+  r.base_work = in.base;
+  const StageOutcome v = vouch_read(in, r);
+  return finish(v.status, v.reason);
+}
+
+/// attempts_vouched on the odometry in.odometry chose; when the automatic choice's base
+/// odometry ends without a success, the stages run again on the joint odometry, whose result is
+/// then the call's (odometry_choice.hpp: what the default gave before the choice existed).
+template <class FA, class FB>
+PairCalibration attempts_on_chosen_odometry(const AttemptInputs<FA, FB>& in,
+                                            const StartRotations* starts, PairCalibration& r,
+                                            const Finish& finish) {
+  const PairCalibration before = r;
+  PairCalibration result = attempts_vouched(in, starts, r, finish);
+  if (result.success || !in.odometry.joint_if_refused) return result;
+  AttemptInputs<FA, FB> joint = in;
+  joint.odometry = joint_after_refusal(in.odometry, to_string(r.status), r.reason);
+  r = before;
+  return attempts_vouched(joint, starts, r, finish);
 }
 
 /// The pipeline on validated inputs (calibrate_pair_in_place).
@@ -290,17 +337,11 @@ PairCalibration run_pipeline(const FA& frames_a, const std::vector<double>& time
                                  has_stage(options.stages, Stage::terra),
                                  has_stage(options.stages, Stage::jeep),
                                  has_stage(options.stages, Stage::hots),
-                                 options.base_work};
+                                 options.base_work,
+                                 hots_odometry_choice(frames_a, times_a, options)};
   r.point_times_base = point_times_before(in.a.frames);
   r.point_times_target = point_times_before(in.b.frames);
-  if (!in.run_terra) {
-    r.T_base_target = *options.initial;
-    const StageOutcome o = run_attempt(in, *options.initial, "", true, r);
-    r.base_work = in.base;
-    finish(o.status, o.reason);
-    const StageOutcome v = vouch_read(in, r);
-    return finish(v.status, v.reason);
-  }
+  if (!in.run_terra) return attempts_on_chosen_odometry(in, nullptr, r, finish);
   const auto starts = terra_step(frames_a, times_a, frames_b, times_b, options, r);
   if (!starts)
     return finish(CalibrateStatus::terra_failed,
@@ -310,10 +351,7 @@ PairCalibration run_pipeline(const FA& frames_a, const std::vector<double>& time
     point_times_read(in, r);
     return terra_only(*starts, r, finish);
   }
-  try_hypotheses(in, *starts, r, finish);
-  r.base_work = in.base;
-  const StageOutcome v = vouch_read(in, r);
-  return finish(v.status, v.reason);
+  return attempts_on_chosen_odometry(in, &*starts, r, finish);
 }
 
 }  // namespace calibrate_detail

@@ -8,7 +8,8 @@
 //     Names must be unique and not empty (the result file keys on them).
 //   - Direct: calibrate_pair(base, target, options.pair) for every target. options.pair.initial
 //     is ignored: each LiDAR carries its own guess, RigLidar::initial = T_base_lidar (needed
-//     only when options.pair.stages skip terra). With tuning.hots_odometry base, the base's own
+//     only when options.pair.stages skip terra). With the base's own odometry (tuning.hots_odometry
+//     base, or automatic choosing it: the choice looks at the base alone), the base's own
 //     odometry and HOTS's preparation of its frames are done once, by the first target that
 //     needs them, and given to the others: each direct result is the one calibrate_pair gives
 //     alone, bit for bit.

@@ -310,7 +310,17 @@ TEST_CASE("ulc calibrate --stages hots is accepted and runs odometry and HOTS ov
   CHECK(rb[1].stages.at("hots").at("base_prepared_reused").get<bool>() == true);
   CHECK(rb[0].T_base_target.isApprox(rb[1].T_base_target, 1e-12));
   CHECK(rb[0].status == rb[1].status);
-  CHECK(rs[0].stages.at("hots").at("odometry_reused").get<bool>() == false);  // the default
+  CHECK(rb[0].stages.at("hots").at("odometry").get<std::string>() == "base");
+  CHECK(rs[0].stages.at("hots").at("odometry_reused").get<bool>() == false);    // the default:
+  CHECK(rs[0].stages.at("hots").at("odometry").get<std::string>() == "joint");  // a short drive
+  CHECK_THAT(rs[0].stages.at("hots").at("odometry_choice").get<std::string>(),
+             Catch::Contains("spans"));
+
+  // One odometry or the other, not both.
+  const auto both = run_command(kUlc + " calibrate --quiet --base-odometry --joint-odometry" +
+                                d.pair_args() + " --output " + quote(out));
+  CHECK(both.exit_code == 2);
+  CHECK_THAT(both.output, Catch::Contains("excludes"));
 }
 
 TEST_CASE("a target that cannot be calibrated: exit code 1, and its entry says why",

@@ -174,3 +174,13 @@ def test_base_odometry_is_the_command_lines(drive, tmp_path):
         cli = json.load(f)
     assert without_timings(json.loads(ours.to_json())) == without_timings(cli)
     assert cli["results"][0]["stages"]["hots"]["odometry_reused"] is False
+    assert cli["results"][0]["stages"]["hots"]["odometry"] == "base"
+    # base_odometry=False is --joint-odometry; the default (None) lets the pipeline choose,
+    # which on this short drive is the joint odometry too.
+    joint = ulc.calibrate(lidar(drive, "lidar64"), lidar(drive, "lidar32"), stages="hots",
+                          initial=guess, synced_clocks=True, base_odometry=False)
+    chosen = ulc.calibrate(lidar(drive, "lidar64"), lidar(drive, "lidar32"), stages="hots",
+                           initial=guess, synced_clocks=True)
+    assert joint.stages["hots"]["odometry"] == "joint"
+    assert chosen.stages["hots"]["odometry"] == "joint"
+    np.testing.assert_array_equal(joint.T_base_target, chosen.T_base_target)

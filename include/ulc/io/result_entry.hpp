@@ -233,6 +233,8 @@ inline Json hots_to_json(const HotsReport& h) {
   phases["sequence"] = s.sequence_seconds;
   j["phase_seconds"] = std::move(phases);
   j["odometry_seconds"] = h.odometry_seconds;
+  j["odometry"] = to_string(h.odometry);  // "joint" or "base"
+  j["odometry_choice"] = h.odometry_choice;
   j["odometry_reused"] = h.odometry_reused;
   j["base_prepared_reused"] = h.base_prepared_reused;
   j["seconds"] = h.seconds;
