@@ -41,7 +41,8 @@
 //     left, base frame; m, rad) = the whole-sequence step's jackknife covariance of C
 //     (sequence_extrinsic.hpp) plus delta delta^T, delta = log(C_start C^-1) the step's move from
 //     the graph's or the synchronisation's C: two models of the same data, whose disagreement is
-//     a sample of an error every frame shares (refine_steps.hpp, sequence_step). When refine's
+//     a sample of an error every frame shares (refine_steps.hpp, sequence_step; not when the
+//     step adopted a new clock offset, which the graph's C did not have). When refine's
 //     own start lies beyond that covariance's 3-sigma ellipsoid, the step runs again from it and
 //     the two answers' difference is added the same way (rerun_from_start). With that step disabled
 //     or singular: the spread of the per-pair extrinsics, or without synchronisation the graph's

@@ -562,8 +562,15 @@ bool sequence_step(RefineState<S>& s, const RefineOptions& options, RefineResult
     // trajectory bias, a modelling error of the whole scene) is invisible to it. The step's
     // move from the graph's (or synchronisation's) C, a second model of the same data, is one
     // sample of that disagreement, and a rerun from refine's own start another: each added as
-    // a rank-one term (hots.hpp).
-    const Vec6d moved = ulc::se3_log(Isometry3d(graph_answer * result.extrinsic.inverse()));
+    // a rank-one term (hots.hpp). When the step adopted a new clock offset, the graph's C was
+    // solved at the old one and the move is mostly the offset's change times the speed (60 s
+    // 64-32 drive, target 50 ms late: the synchronisation's 30.3 ms left the graph's C 12.5 cm
+    // along the drive from the step's, which found 49.9 ms and lies 0.7 mm from the truth; as
+    // a term it made sigma 12.3 cm and the result uncertain). The rerun, solved at the step's
+    // offset, is then the only sample.
+    const Vec6d moved = st.sequence.time_offset_refined
+                            ? Vec6d::Zero()
+                            : ulc::se3_log(Isometry3d(graph_answer * result.extrinsic.inverse()));
     result.covariance_6x6 = st.sequence.covariance_6x6 + moved * moved.transpose();
     const Vec6d rerun = rerun_from_start(s, step, result.covariance_6x6, result);
     result.covariance_6x6 += rerun * rerun.transpose();

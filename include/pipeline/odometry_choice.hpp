@@ -10,8 +10,9 @@
 //     (the Horizon of horizon-tele), and short drives, where a few frames of target structure
 //     steady the poses (10 s drives: 32-avia seed 2 uncertain, 32-mid40 seed 1 0.012 -> 0.032
 //     deg; docs/experiments/hots_base_odometry.md).
-//   - Rule: base when the base's frames from frame_index span at least min_span_s seconds and
-//     the base sees all around, else joint. min_span_s = 30 s: on the paper's pairs with a
+//   - Rule: base when the base's frames from frame_index last at least min_duration_s seconds
+//     (their span and one mean frame period: 300 frames at 10 Hz last 30 s) and the base sees
+//     all around, else joint. min_duration_s = 30 s: on the paper's pairs with a
 //     360-degree base, 30 s and 60 s drives gave the same answers with either odometry
 //     (docs/experiments/hots_base_odometry.md, "Longer drives").
 //   - "Sees all around": at least min_azimuth_coverage of the azimuth_sectors sectors of equal
@@ -78,6 +79,14 @@ double azimuth_coverage(const Cloud& cloud, const OdometryChoiceOptions& options
   return count / static_cast<double>(sectors);
 }
 
+/// How long frames at these timestamps last: their span and one mean frame period (0 for fewer
+/// than two).
+inline double recorded_duration(const std::vector<double>& times) {
+  if (times.size() < 2) return 0.0;
+  const double span = times.back() - times.front();
+  return span + span / static_cast<double>(times.size() - 1);
+}
+
 /// The median coverage of the first, middle and last frame of `frames` (0 with none).
 template <class Frames>
 double median_azimuth_coverage(const Frames& frames, const OdometryChoiceOptions& options) {
@@ -98,12 +107,12 @@ OdometryChoice choose_odometry(HotsOdometry asked, const Frames& base_frames,
   if (asked != HotsOdometry::automatic)
     return {asked, std::string("asked for the ") + to_string(asked) + " odometry"};
   char text[160];
-  const double span = base_times.empty() ? 0.0 : base_times.back() - base_times.front();
-  if (!(span >= options.min_span_s)) {
+  const double duration = recorded_duration(base_times);
+  if (!(duration >= options.min_duration_s)) {
     std::snprintf(text, sizeof text,
-                  "joint: the drive spans %.1f s, under the %.0f s where the base's own odometry "
+                  "joint: the drive lasts %.1f s, under the %.0f s where the base's own odometry "
                   "serves as well",
-                  span, options.min_span_s);
+                  duration, options.min_duration_s);
     return {HotsOdometry::joint, text};
   }
   const double coverage = median_azimuth_coverage(base_frames, options);
@@ -115,9 +124,9 @@ OdometryChoice choose_odometry(HotsOdometry asked, const Frames& base_frames,
     return {HotsOdometry::joint, text};
   }
   std::snprintf(text, sizeof text,
-                "base: the drive spans %.1f s and the base sees %.0f %% of the azimuth around "
+                "base: the drive lasts %.1f s and the base sees %.0f %% of the azimuth around "
                 "it; its own odometry is run once for every hypothesis and target",
-                span, 100.0 * coverage);
+                duration, 100.0 * coverage);
   return {HotsOdometry::base, text, true};
 }
 

@@ -48,7 +48,7 @@ enum class HotsOdometry {
   /// (docs/experiments/hots_base_odometry.md).
   base,
   /// The pipeline chooses (pipeline/odometry_choice.hpp): base on a drive of at least
-  /// StageTuning::odometry_choice.min_span_s whose base sees all around, joint otherwise. The
+  /// StageTuning::odometry_choice.min_duration_s whose base sees all around, joint otherwise. The
   /// default.
   automatic,
 };

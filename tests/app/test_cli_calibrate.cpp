@@ -314,7 +314,7 @@ TEST_CASE("ulc calibrate --stages hots is accepted and runs odometry and HOTS ov
   CHECK(rs[0].stages.at("hots").at("odometry_reused").get<bool>() == false);    // the default:
   CHECK(rs[0].stages.at("hots").at("odometry").get<std::string>() == "joint");  // a short drive
   CHECK_THAT(rs[0].stages.at("hots").at("odometry_choice").get<std::string>(),
-             Catch::Contains("spans"));
+             Catch::Contains("lasts"));
 
   // One odometry or the other, not both.
   const auto both = run_command(kUlc + " calibrate --quiet --base-odometry --joint-odometry" +

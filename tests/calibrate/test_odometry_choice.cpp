@@ -55,16 +55,16 @@ TEST_CASE("the choice: base for a long drive of an all-around base, else joint, 
   const ulc::OdometryChoiceOptions o;  // 30 s, 90 % of the azimuth
   const std::vector<ulc::PointCloud<float>> spinning(3, arc(-180.0, 179.0, 20.0));
   const std::vector<ulc::PointCloud<float>> narrow(3, arc(-39.5, 39.5, 20.0));  // 16 sectors
-  const std::vector<double> long_drive{100.0, 130.0, 160.0};  // three frames over 60 s
-  const std::vector<double> short_drive{100.0, 105.0, 110.0};
+  const std::vector<double> long_drive{100.0, 130.0, 160.0};   // three frames of 30 s: 90 s
+  const std::vector<double> short_drive{100.0, 105.0, 110.0};  // 15 s
 
   const auto chosen = ulc::choose_odometry(HotsOdometry::automatic, spinning, long_drive, o);
   CHECK(chosen.odometry == HotsOdometry::base);
-  CHECK_THAT(chosen.why, Catch::Contains("60.0 s") && Catch::Contains("100 %"));
+  CHECK_THAT(chosen.why, Catch::Contains("lasts 90.0 s") && Catch::Contains("100 %"));
 
   const auto brief = ulc::choose_odometry(HotsOdometry::automatic, spinning, short_drive, o);
   CHECK(brief.odometry == HotsOdometry::joint);
-  CHECK_THAT(brief.why, Catch::Contains("spans 10.0 s") && Catch::Contains("30 s"));
+  CHECK_THAT(brief.why, Catch::Contains("lasts 15.0 s") && Catch::Contains("30 s"));
 
   const auto ahead = ulc::choose_odometry(HotsOdometry::automatic, narrow, long_drive, o);
   CHECK(ahead.odometry == HotsOdometry::joint);
@@ -96,17 +96,17 @@ TEST_CASE("the pipeline reports its choice, and the base's odometry chosen is th
   const auto by_default = ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, o);
   REQUIRE(by_default.hots);
   CHECK(by_default.hots->odometry == HotsOdometry::joint);
-  CHECK_THAT(by_default.hots->odometry_choice, Catch::Contains("joint: the drive spans"));
+  CHECK_THAT(by_default.hots->odometry_choice, Catch::Contains("joint: the drive lasts"));
   CHECK_FALSE(by_default.base_work.odometry);
 
   // A span the 3 s drive passes: the HDL-64E sees all around, so the base's own odometry, and
   // then the same answer as when it is asked for.
-  o.tuning.odometry_choice.min_span_s = 1.0;
+  o.tuning.odometry_choice.min_duration_s = 1.0;
   const auto chosen = ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, o);
   INFO(ulc::to_string(chosen.status) << ": " << chosen.reason);
   REQUIRE(chosen.hots);
   CHECK(chosen.hots->odometry == HotsOdometry::base);
-  CHECK_THAT(chosen.hots->odometry_choice, Catch::StartsWith("base: the drive spans"));
+  CHECK_THAT(chosen.hots->odometry_choice, Catch::StartsWith("base: the drive lasts"));
   CHECK(chosen.base_work.odometry);
   o.tuning.hots_odometry = HotsOdometry::base;
   const auto asked = ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, o);
