@@ -23,7 +23,7 @@
 //     target of a rig gets the same choice and shares the base's work (rig.hpp).
 //   - When the automatic choice's base odometry ends without a success (refused, uncertain,
 //     failed), the stages after TERRA run again on the joint odometry and that result is the
-//     call's: a drive the joint odometry calibrated before the choice existed still is (64-tele,
+//     call's: every drive the joint odometry calibrates is still calibrated (64-tele,
 //     60 s: the base's odometry gave the right answer but a covariance of 6.1 cm along y,
 //     uncertain; the joint one 2.9 cm, ok). The refusals cost both runs.
 //   - `why` says, in one sentence, which was chosen and why; the result file reports both

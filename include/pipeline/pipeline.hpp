@@ -307,7 +307,7 @@ PairCalibration attempts_vouched(const AttemptInputs<FA, FB>& in, const StartRot
 
 /// attempts_vouched on the odometry in.odometry chose; when the automatic choice's base
 /// odometry ends without a success, the stages run again on the joint odometry, whose result is
-/// then the call's (odometry_choice.hpp: what the default gave before the choice existed).
+/// then the call's, the one the joint odometry alone gives (odometry_choice.hpp).
 template <class FA, class FB>
 PairCalibration attempts_on_chosen_odometry(const AttemptInputs<FA, FB>& in,
                                             const StartRotations* starts, PairCalibration& r,
