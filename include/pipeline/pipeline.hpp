@@ -267,15 +267,13 @@ StageOutcome vouch_read(const AttemptInputs<FA, FB>& in, PairCalibration& r) {
   return vouch(in, r);
 }
 
-/// StageTuning::hots_odometry resolved on the base's frames from frame_index, when HOTS is
-/// asked for (odometry_choice.hpp); joint otherwise (no odometry runs).
-template <class FA>
-OdometryChoice hots_odometry_choice(const FA& frames_a, const std::vector<double>& times_a,
-                                    const CalibrateOptions& options) {
-  const std::size_t i = options.frame_index;
-  if (!has_stage(options.stages, Stage::hots)) return {};
-  return choose_odometry(options.tuning.hots_odometry, FrameRange<FA>(frames_a, i),
-                         times_from(times_a, i), options.tuning.odometry_choice);
+/// StageTuning::hots_odometry resolved on the base's frames and times the stages read, when
+/// HOTS is asked for (odometry_choice.hpp); joint otherwise (no odometry runs).
+template <class FA, class FB>
+OdometryChoice hots_odometry_choice(const AttemptInputs<FA, FB>& in) {
+  if (!in.run_hots) return {};
+  return choose_odometry(in.options.tuning.hots_odometry, in.a.frames, in.a.times,
+                         in.options.tuning.odometry_choice);
 }
 
 /// TERRA alone: its best rotation is the answer.
@@ -312,9 +310,10 @@ template <class FA, class FB>
 PairCalibration attempts_on_chosen_odometry(const AttemptInputs<FA, FB>& in,
                                             const StartRotations* starts, PairCalibration& r,
                                             const Finish& finish) {
+  if (!in.odometry.joint_if_refused) return attempts_vouched(in, starts, r, finish);
   const PairCalibration before = r;
   PairCalibration result = attempts_vouched(in, starts, r, finish);
-  if (result.success || !in.odometry.joint_if_refused) return result;
+  if (result.success) return result;
   AttemptInputs<FA, FB> joint = in;
   joint.odometry = joint_after_refusal(in.odometry, to_string(r.status), r.reason);
   r = before;
@@ -330,15 +329,16 @@ PairCalibration run_pipeline(const FA& frames_a, const std::vector<double>& time
   const std::vector<double> times_b = on_base_clock(times_b_own, options.time_offset_s);
   r.time_offset_s = options.time_offset_s.value_or(0.0);
   const std::size_t i = options.frame_index;
-  const AttemptInputs<FA, FB> in{{FrameRange<FA>(frames_a, i), times_from(times_a, i), {}},
-                                 {FrameRange<FB>(frames_b, i), times_from(times_b, i), {}},
-                                 options,
-                                 hots_options(options),
-                                 has_stage(options.stages, Stage::terra),
-                                 has_stage(options.stages, Stage::jeep),
-                                 has_stage(options.stages, Stage::hots),
-                                 options.base_work,
-                                 hots_odometry_choice(frames_a, times_a, options)};
+  AttemptInputs<FA, FB> in{{FrameRange<FA>(frames_a, i), times_from(times_a, i), {}},
+                           {FrameRange<FB>(frames_b, i), times_from(times_b, i), {}},
+                           options,
+                           hots_options(options),
+                           has_stage(options.stages, Stage::terra),
+                           has_stage(options.stages, Stage::jeep),
+                           has_stage(options.stages, Stage::hots),
+                           options.base_work,
+                           {}};
+  in.odometry = hots_odometry_choice(in);
   r.point_times_base = point_times_before(in.a.frames);
   r.point_times_target = point_times_before(in.b.frames);
   if (!in.run_terra) return attempts_on_chosen_odometry(in, nullptr, r, finish);
