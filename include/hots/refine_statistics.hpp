@@ -19,6 +19,7 @@ namespace hots {
 
 using ulc::Isometry3d;
 using ulc::Mat6d;
+using ulc::Vec6d;
 
 enum class SequenceExtrinsicStatus { ok, disabled, invalid_input, registration_failed };
 
@@ -47,6 +48,10 @@ struct SequenceExtrinsicResult {
   bool time_offset_trusted = true;     ///< it passed (true when it did not run)
   const char* time_offset_doubt = "";  ///< why not, one sentence
   double half_time_offset_s[2] = {0.0, 0.0};  ///< the first and the second half's dt
+  /// dC/ddt at the joint solve's answer, -H_CC^-1 H_Ct ([rho; phi] per second): how far C
+  /// moves for an error of the offset; zero when the joint solve did not run or H_CC is
+  /// singular.
+  Vec6d offset_sensitivity = Vec6d::Zero();
   /// 1 / (H_77 (H^-1)_77) of the joint normal matrix: the share of dt's information that a
   /// change of C cannot explain (1: independent of C, 0: a translation along the road would do).
   double time_observability = 0.0;

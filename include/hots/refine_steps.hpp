@@ -522,14 +522,15 @@ RefineStatus solve_passes(RefineState<S>& s, const RefineOptions& options, Refin
 /// it began and its jackknife, the local curvature, sees nothing (bench_covariance, side-bpearl
 /// seed 5, 10 s: from the graph's C the step ended 29 cm off along the drive with sigma 2.6 cm;
 /// from JEEP's, 0.3 cm off, it ended 6.3 cm off; the two costs 0.4 % apart).
-/// The rerun shares the step's prepared submaps and frames (SequenceStep::solve_extrinsic).
+/// The rerun shares the step's prepared submaps and frames and solves as the step ended, with
+/// the offset free only when the step refined it (SequenceStep::solve_extrinsic).
 template <typename S>
 Vec6d rerun_from_start(const RefineState<S>& s, SequenceStep<S>& step, const Mat6d& covariance,
                        RefineResult& result) {
   const Vec6d away = ulc::se3_log(Isometry3d(s.start * result.extrinsic.inverse()));
   if (ulc::within_three_sigma(away, covariance)) return Vec6d::Zero();
   SequenceExtrinsicResult& rerun = result.statistics.sequence_rerun;
-  rerun = step.solve_extrinsic(s.start);
+  rerun = step.solve_extrinsic(s.start, result.statistics.sequence.time_offset_refined);
   if (!rerun.ok()) return Vec6d::Zero();
   return ulc::se3_log(Isometry3d(rerun.extrinsic * result.extrinsic.inverse()));
 }
@@ -567,7 +568,8 @@ bool sequence_step(RefineState<S>& s, const RefineOptions& options, RefineResult
     // 64-32 drive, target 50 ms late: the synchronisation's 30.3 ms left the graph's C 12.5 cm
     // along the drive from the step's, which found 49.9 ms and lies 0.7 mm from the truth; as
     // a term it made sigma 12.3 cm and the result uncertain). The rerun, solved at the step's
-    // offset, is then the only sample.
+    // offset, is then the only sample besides the step's own term for the offset's error
+    // (sequence_extrinsic.hpp, offset_error_term).
     const Vec6d moved = st.sequence.time_offset_refined
                             ? Vec6d::Zero()
                             : ulc::se3_log(Isometry3d(graph_answer * result.extrinsic.inverse()));

@@ -55,7 +55,12 @@
 //     give each a leverage the plain sandwich A^-1 M A^-1 ignores). With dt solved alongside C
 //     it is the 7x7 jackknife's 6x6 block, so dt's uncertainty widens C's. Widened for its
 //     few frames by Hotelling's T^2 (ulc/core/small_sample.hpp). Measured in
-//     docs/experiments/covariance_coverage.md.
+//     docs/experiments/covariance_coverage.md. When dt was adopted and the halves' check ran,
+//     the offset's error that every frame shares (a bias the jackknife cannot see) is added as
+//     a rank-one term: half the halves' disagreement, one sample of that error, carried into C
+//     by dC/ddt = -H_CC^-1 H_Ct (offset_sensitivity). On the 60 s 64-32 drive with a 50 ms
+//     offset the jackknife alone left C's 1.9 mm error at e = 2.05, outside its 3-sigma
+//     ellipsoid (docs/pipeline.md, "Covariance").
 //   - The result keeps C and dt of the input when the registration fails (status says why).
 //   - Nothing here throws (a throwing progress hook passes through) or prints; the same results
 //     for any number of threads (per-term deterministic reductions summed in term order).
@@ -533,10 +538,29 @@ const char* input_problem(const std::vector<std::vector<ulc::Vec3<S>>>& frames_a
   return nullptr;
 }
 
+/// dC/ddt = -H_CC^-1 H_Ct from the joint normal matrix at the answer (see
+/// SequenceExtrinsicResult::offset_sensitivity); zero when H_CC cannot be inverted.
+inline Vec6d offset_sensitivity(const Mat7& H) {
+  const Eigen::LDLT<Mat6d> ldlt(H.topLeftCorner<6, 6>());
+  if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) return Vec6d::Zero();
+  const Vec6d sensitivity = -ldlt.solve(H.topRightCorner<6, 1>());
+  return sensitivity.allFinite() ? sensitivity : Vec6d::Zero();
+}
+
+/// The offset's shared error carried into C (see the conventions): zero unless dt was adopted
+/// and the halves' check ran.
+inline Mat6d offset_error_term(const SequenceExtrinsicResult& result) {
+  if (!result.time_offset_refined || !result.time_offset_checked) return Mat6d::Zero();
+  const double spread = 0.5 * (result.half_time_offset_s[0] - result.half_time_offset_s[1]);
+  const Vec6d moved = result.offset_sensitivity * spread;
+  return moved * moved.transpose();
+}
+
 /// The joint solve's dt statistics, and whether dt is adopted.
 inline void judge_joint_offset(const Solve& s, double dt0, const SequenceExtrinsicOptions& o,
                                SequenceExtrinsicResult& result) {
   result.joint_time_offset_s = s.dt;
+  result.offset_sensitivity = offset_sensitivity(s.sums.H);
   result.time_sigma_s = time_sigma(s.sums.H, s.sums.term_g, o.time_cluster_frames);
   result.time_observability = time_observability(s.sums.H);
   result.time_offset_refined = o.estimate_time_offset && result.time_sigma_s < o.max_time_sigma_s &&
@@ -657,52 +681,81 @@ class SequenceStep {
   /// See the header comment. progress (optional) gets 3/6 .. 6/6 after the solve, the offset
   /// check, the solve without the offset and the covariance.
   SequenceExtrinsicResult solve(const Isometry3d& C0, const ulc::StepProgress& progress = {}) {
-    return run(C0, true, progress);
+    return run(C0, progress);
   }
 
-  /// The extrinsic alone from another start: solve()'s solves, to the same answer, without the
-  /// offset's trust check and the covariance (what a second start is asked for: where it ends).
-  SequenceExtrinsicResult solve_extrinsic(const Isometry3d& C0) { return run(C0, false, {}); }
+  /// The extrinsic alone from another start, solved the way solve() ended: with the clock offset
+  /// free from the step's start dt0 when solve() adopted a refined offset
+  /// (`time_offset_refined`), held at dt0 otherwise. That solve is the one solve() would end on
+  /// from C0 (to the bit when its offset judgement agrees), without the joint solve it judges
+  /// the offset by, the offset's trust check and the covariance: what a second start is asked
+  /// for, where it ends, at about half the cost of solve() on a drive with synchronised clocks.
+  SequenceExtrinsicResult solve_extrinsic(const Isometry3d& C0, bool time_offset_refined) {
+    SequenceExtrinsicResult result = started(C0);
+    if (result.status != SequenceExtrinsicStatus::ok) return result;
+    const sequence_detail::Solve s =
+        sequence_detail::solve(*problem_, C0, dt0_, time_offset_refined, o_, result.iterations);
+    if (!s.ok) return failed(C0, SequenceExtrinsicStatus::registration_failed, s.reason, result);
+    sequence_detail::take_solve(s, result);
+    result.time_offset_refined = time_offset_refined;
+    return result;
+  }
 
  private:
-  SequenceExtrinsicResult run(const Isometry3d& C0, bool full, const ulc::StepProgress& progress) {
-    namespace d = sequence_detail;
-    auto done = [&progress](int sub_steps) {
-      if (progress) progress(sub_steps / 6.0);
-    };
+  /// A result at the start; status invalid_input when no solve can run from C0, disabled when
+  /// the step is.
+  SequenceExtrinsicResult started(const Isometry3d& C0) const {
     SequenceExtrinsicResult result;
     result.extrinsic = C0;
     result.time_offset_s = result.joint_time_offset_s = dt0_;
     if (!o_.enabled) return result;
-    auto fail = [&](SequenceExtrinsicStatus status, const char* why) {
-      result.status = status;
-      result.reason = why;
-      result.extrinsic = C0;
-      result.time_offset_s = dt0_;
-      return result;
-    };
     if (!C0.matrix().allFinite())
-      return fail(SequenceExtrinsicStatus::invalid_input, "the start extrinsic is not finite");
-    if (input_error_) return fail(SequenceExtrinsicStatus::invalid_input, input_error_);
+      return failed(C0, SequenceExtrinsicStatus::invalid_input, "the start extrinsic is not finite",
+                    result);
+    if (input_error_)
+      return failed(C0, SequenceExtrinsicStatus::invalid_input, input_error_, result);
+    result.status = SequenceExtrinsicStatus::ok;
     result.targets = submaps_.planes.size();
+    return result;
+  }
+
+  /// result failed with `status` and `why`, back at the start.
+  SequenceExtrinsicResult failed(const Isometry3d& C0, SequenceExtrinsicStatus status,
+                                 const char* why, SequenceExtrinsicResult result) const {
+    result.status = status;
+    result.reason = why;
+    result.extrinsic = C0;
+    result.time_offset_s = dt0_;
+    return result;
+  }
+
+  SequenceExtrinsicResult run(const Isometry3d& C0, const ulc::StepProgress& progress) {
+    namespace d = sequence_detail;
+    auto done = [&progress](int sub_steps) {
+      if (progress) progress(sub_steps / 6.0);
+    };
+    SequenceExtrinsicResult result = started(C0);
+    if (result.status != SequenceExtrinsicStatus::ok) return result;
+    auto fail = [&](const char* why) {
+      return failed(C0, SequenceExtrinsicStatus::registration_failed, why, result);
+    };
     auto& problem = *problem_;
     const bool joint = o_.estimate_time_offset || o_.check_time_offset;
     d::Solve s = d::solve(problem, C0, dt0_, joint, o_, result.iterations);
-    if (!s.ok) return fail(SequenceExtrinsicStatus::registration_failed, s.reason);
+    if (!s.ok) return fail(s.reason);
     if (joint) d::judge_joint_offset(s, dt0_, o_, result);
     done(3);
-    if (full && o_.check_time_offset) d::check_offset(problem, s, dt0_, o_, result);
+    if (o_.check_time_offset) d::check_offset(problem, s, dt0_, o_, result);
     done(4);
     if (joint && !result.time_offset_refined) {
       s = d::solve(problem, C0, dt0_, false, o_, result.iterations);
-      if (!s.ok) return fail(SequenceExtrinsicStatus::registration_failed, s.reason);
+      if (!s.ok) return fail(s.reason);
     }
     done(5);
     d::take_solve(s, result);
-    if (!full) return result;
     if (const auto c =
             d::extrinsic_covariance(problem, s, joint && result.time_offset_refined, o_)) {
-      result.covariance_6x6 = *c;
+      result.covariance_6x6 = *c + d::offset_error_term(result);
       result.has_covariance = true;
     }
     done(6);

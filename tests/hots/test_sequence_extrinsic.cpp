@@ -11,6 +11,8 @@
 #include "hots/sequence_extrinsic.hpp"
 #include "hots_drive.hpp"
 #include "hots_test_util.hpp"
+#include "ulc/core/lie.hpp"
+#include "ulc/core/mahalanobis.hpp"
 #include "ulc/core/pose_error.hpp"
 
 namespace {
@@ -18,6 +20,7 @@ namespace {
 using hots_test::kDeg;
 using ulc::Isometry3d;
 using ulc::Vec3d;
+using ulc::Vec6d;
 
 struct Prepared {
   std::vector<std::vector<ulc::Vec3<float>>> fa, fb;
@@ -226,7 +229,7 @@ TEST_CASE("a prepared whole-sequence step solved from a second start ends where 
   const hots::SequenceExtrinsicResult r1 = step.solve(first);
   REQUIRE(r1.ok());
   CHECK(r1.time_offset_checked);
-  const hots::SequenceExtrinsicResult again = step.solve_extrinsic(second);
+  const hots::SequenceExtrinsicResult again = step.solve_extrinsic(second, r1.time_offset_refined);
   const hots::SequenceExtrinsicResult fresh = c.solve(c.b.timestamps, second, o);
   REQUIRE(again.ok());
   REQUIRE(fresh.ok());
@@ -238,4 +241,92 @@ TEST_CASE("a prepared whole-sequence step solved from a second start ends where 
   const hots::SequenceExtrinsicResult fresh_first = c.solve(c.b.timestamps, first, o);
   CHECK(r1.frames == fresh_first.frames);
   CHECK(r1.frames == again.frames);
+}
+
+TEST_CASE("a second start on a step that refined the clock offset solves with the offset free",
+          "[hots][sequence]") {
+  // b's clock 50 ms behind, the step started at 30 ms (as from a synchronisation short of the
+  // truth) and free to refine the offset: solve() adopts the joint solve, and a second start
+  // solved the same way ends where a fresh step from it does.
+  const DriveCase c;
+  std::vector<double> late_b = c.b.timestamps;
+  for (double& t : late_b) t -= 0.05;
+  std::mt19937_64 rng(10);
+  const Isometry3d first = jeep_test::disturbed(c.C, rng, 0.2 * kDeg, 0.03);
+  const Isometry3d second = jeep_test::disturbed(c.C, rng, 0.3 * kDeg, 0.05);
+  hots::SequenceExtrinsicOptions o;
+  o.check_time_offset = false;
+  o.frame_stride = 2;
+  const double dt0 = 0.03;
+  hots::SequenceStep<float> step(c.p.ha, c.p.fa, c.a.timestamps, c.d.truth_a, c.p.fb, late_b, dt0,
+                                 o);
+  const hots::SequenceExtrinsicResult r1 = step.solve(first);
+  INFO("joint " << r1.joint_time_offset_s * 1e3 << " ms, sigma " << r1.time_sigma_s * 1e3 << " ms");
+  REQUIRE(r1.ok());
+  REQUIRE(r1.time_offset_refined);
+  const hots::SequenceExtrinsicResult again = step.solve_extrinsic(second, true);
+  const hots::SequenceExtrinsicResult fresh = hots::sequence_extrinsic(
+      c.p.ha, c.p.fa, c.a.timestamps, c.d.truth_a, c.p.fb, late_b, second, dt0, o);
+  REQUIRE(again.ok());
+  REQUIRE(fresh.time_offset_refined);
+  CHECK(again.extrinsic.matrix() == fresh.extrinsic.matrix());
+  CHECK(again.time_offset_s == fresh.time_offset_s);
+  CHECK(std::abs(again.time_offset_s - 0.05) < 0.01);
+  // Held at the step's start offset instead, the same start ends elsewhere: the offset's 20 ms
+  // error shows as a move along the drive.
+  const hots::SequenceExtrinsicResult held = step.solve_extrinsic(second, false);
+  REQUIRE(held.ok());
+  CHECK(held.time_offset_s == dt0);
+  CHECK(ulc::pose_error(again.extrinsic, held.extrinsic).translation_m > 0.01);
+  CHECK(ulc::pose_error(c.C, again.extrinsic).translation_m <
+        ulc::pose_error(c.C, held.extrinsic).translation_m);
+}
+
+TEST_CASE(
+    "C's sensitivity to the clock offset matches finite differences and widens C's covariance",
+    "[hots][sequence]") {
+  // b's clock 50 ms behind, the step started at 30 ms and free to refine it, the halves' check
+  // on: dC/ddt = -H_CC^-1 H_Ct at the answer against C re-solved at dt +- 2 ms, and the
+  // covariance carrying the offset's error (half the halves' disagreement times dC/ddt).
+  const DriveCase c;
+  std::vector<double> late_b = c.b.timestamps;
+  for (double& t : late_b) t -= 0.05;
+  hots::SequenceExtrinsicOptions o;
+  o.frame_stride = 2;
+  o.min_frames = 0;
+  o.min_time_observability = 0.0;  // the halves run however short the drive
+  const hots::SequenceExtrinsicResult r = hots::sequence_extrinsic(
+      c.p.ha, c.p.fa, c.a.timestamps, c.d.truth_a, c.p.fb, late_b, c.C, 0.03, o);
+  REQUIRE(r.ok());
+  REQUIRE(r.time_offset_refined);
+  REQUIRE(r.time_offset_checked);
+  REQUIRE(r.has_covariance);
+
+  hots::SequenceExtrinsicOptions held = o;
+  held.estimate_time_offset = false;
+  held.check_time_offset = false;
+  const double h = 0.002;
+  auto at = [&](double dt) {
+    const auto s = hots::sequence_extrinsic(c.p.ha, c.p.fa, c.a.timestamps, c.d.truth_a, c.p.fb,
+                                            late_b, r.extrinsic, dt, held);
+    REQUIRE(s.ok());
+    return s.extrinsic;
+  };
+  const Vec6d numeric =
+      ulc::se3_log(Isometry3d(at(r.time_offset_s + h) * at(r.time_offset_s - h).inverse())) /
+      (2.0 * h);
+  const Vec6d analytic = r.offset_sensitivity;
+  INFO("analytic " << analytic.transpose() << "\nnumeric  " << numeric.transpose());
+  CHECK(analytic.head<3>().norm() > 1.0);  // metres per second: about the drive's speed
+  CHECK((analytic - numeric).head<3>().norm() < 0.2 * numeric.head<3>().norm());
+  CHECK(analytic.head<3>().dot(numeric.head<3>()) >
+        0.95 * analytic.head<3>().norm() * numeric.head<3>().norm());
+
+  // The covariance holds the offset's term: its 1-sigma sample lies within 1 sigma.
+  const double spread = 0.5 * (r.half_time_offset_s[0] - r.half_time_offset_s[1]);
+  REQUIRE(spread != 0.0);
+  const Vec6d moved = r.offset_sensitivity * spread;
+  const auto d2 = ulc::mahalanobis_sq(moved, r.covariance_6x6);
+  REQUIRE(d2);
+  CHECK(*d2 <= 1.0 + 1e-9);
 }
