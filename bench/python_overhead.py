@@ -13,6 +13,10 @@ One drive (a dataset folder of `ulc simulate`), calibrated in turn, --repeats ti
          Ctrl-C may wait (it is checked at each call).
 Prints each run and the medians; the ratios are taken within each round (same load).
 
+--memory instead measures what the numpy call adds to the process's resident memory: the arrays
+are read (float32) in a fresh process, its peak is reset (/proc/self/clear_refs), the call
+runs, and the peak above the resident memory before the call is printed beside the arrays' size.
+
   PYTHONPATH=build_bench/python python3 bench/python_overhead.py --ulc build_bench/apps/ulc/ulc \
       --drive /tmp/64-32-60 --threads 2 --repeats 3
 """
@@ -82,6 +86,32 @@ def as_float32(lidar):
     return {"frames": [f.astype(np.float32) for f in lidar["frames"]], "times": lidar["times"]}
 
 
+def status_kib(field):
+    with open("/proc/self/status") as f:
+        for line in f:
+            if line.startswith(field + ":"):
+                return int(line.split()[1])
+    raise SystemExit(f"python_overhead: /proc/self/status has no {field}")
+
+
+def memory_run(args):
+    """Peak resident memory the numpy call adds, in this process (see --memory)."""
+    frames = [as_float32(ulc.read_frames(os.path.join(args.drive, n)))
+              for n in (args.base, args.target)]
+    arrays_gb = sum(f.nbytes for lidar in frames for f in lidar["frames"]) / 1e9
+    before_kib = status_kib("VmRSS")
+    with open("/proc/self/clear_refs", "w") as f:
+        f.write("5")  # resets VmHWM to the current resident size
+    seconds, result, _ = numpy_run(args, frames)
+    peak_kib = status_kib("VmHWM")
+    row = dict(arrays_gb=arrays_gb, rss_before_gb=before_kib * 1024 / 1e9,
+               peak_gb=peak_kib * 1024 / 1e9, added_gb=(peak_kib - before_kib) * 1024 / 1e9,
+               seconds=seconds, success=bool(result.success))
+    print(" ".join(f"{k}={v:.3f}" if isinstance(v, float) else f"{k}={v}" for k, v in row.items()))
+    if args.json:
+        print(json.dumps(row))
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--ulc", required=True, help="the ulc program")
@@ -91,7 +121,12 @@ def main():
     p.add_argument("--threads", type=int, default=2)
     p.add_argument("--repeats", type=int, default=3)
     p.add_argument("--json", action="store_true", help="print the figures as JSON too")
+    p.add_argument("--memory", action="store_true",
+                   help="the resident memory the numpy call adds (one call, no timing rounds)")
     args = p.parse_args()
+    if args.memory:
+        memory_run(args)
+        return
 
     out = os.path.join(tempfile.mkdtemp(prefix="ulc_overhead_"), "r.json")
     frames = [as_float32(ulc.read_frames(os.path.join(args.drive, n)))

@@ -4,10 +4,12 @@
 // gives the same result file.
 #include <pybind11/stl.h>
 
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "array_frames.hpp"
 #include "call_control.hpp"
 #include "errors.hpp"
 #include "frames.hpp"
@@ -75,11 +77,12 @@ Isometry3d initial_matrix(const py::object& initial, std::size_t target, std::si
   return isometry_from_python(a, "ulc calibrate: initial");
 }
 
-/// Frames given as arrays: each LiDAR's from frame_index on, as the command line reads them.
+/// Frames given as arrays: each LiDAR's from frame_index on, read from the arrays when the
+/// stages ask (array_frames.hpp), as the command line reads frames from disk.
 struct ArrayRig {
-  std::vector<FloatFrames> frames;
+  std::vector<std::unique_ptr<ArrayFrames>> frames;
   std::vector<std::vector<double>> times;
-  std::vector<RigLidar<FloatFrames>> lidars;
+  std::vector<RigLidar<FrameSource>> lidars;
 };
 
 std::string default_name(std::size_t k, std::size_t count) {
@@ -91,24 +94,23 @@ void read_arrays(const std::vector<Source>& sources, const CalibrateKeywords& k,
   const std::vector<std::string> names = lidar_names(k, sources.size());
   for (std::size_t i = 0; i < sources.size(); ++i) {
     const std::string name = names.empty() ? default_name(i, sources.size()) : names[i];
-    FloatFrames frames = frames_from_python(sources[i].data, "ulc calibrate: " + name);
+    auto frames = std::make_unique<ArrayFrames>(sources[i].data, "ulc calibrate: " + name);
     std::vector<double> times =
-        times_from_python(sources[i].times, frames.size(), "ulc calibrate: " + name + " times");
-    if (k.frame_index >= frames.size())
+        times_from_python(sources[i].times, frames->size(), "ulc calibrate: " + name + " times");
+    if (k.frame_index >= frames->size())
       raise_error("ulc calibrate: --frame-index " + std::to_string(k.frame_index) +
                   " is past the last frame of " + name);
-    const auto first = static_cast<std::ptrdiff_t>(k.frame_index);
-    rig.frames.emplace_back(std::make_move_iterator(frames.begin() + first),
-                            std::make_move_iterator(frames.end()));
-    rig.times.emplace_back(times.begin() + first, times.end());
+    frames->drop_front(k.frame_index);
+    rig.frames.push_back(std::move(frames));
+    rig.times.emplace_back(times.begin() + static_cast<std::ptrdiff_t>(k.frame_index), times.end());
   }
   for (std::size_t i = 0; i < sources.size(); ++i)
     rig.lidars.push_back({names.empty() ? default_name(i, sources.size()) : names[i],
-                          &rig.frames[i], &rig.times[i], std::nullopt});
+                          rig.frames[i].get(), &rig.times[i], std::nullopt});
 }
 
 /// Every target's guess when the stages skip terra (k.choices.initial was checked for text).
-void set_initials(std::vector<RigLidar<FloatFrames>>& lidars, const CalibrateKeywords& k) {
+void set_initials(std::vector<RigLidar<FrameSource>>& lidars, const CalibrateKeywords& k) {
   if (k.initial.is_none()) return;
   const std::optional<std::string> text = initial_text(k.initial);
   for (std::size_t i = 1; i < lidars.size(); ++i)
@@ -144,7 +146,7 @@ RigOptions rig_options(const CalibrateOptions& options, const CalibrateKeywords&
   return rig;
 }
 
-RigResult run(const std::vector<RigLidar<FloatFrames>>& lidars, const CalibrateOptions& options,
+RigResult run(const std::vector<RigLidar<FrameSource>>& lidars, const CalibrateOptions& options,
               const CalibrateKeywords& k) {
   const RigOptions rig = rig_options(options, k, lidars.size());
   const RigCalibration calibration =
@@ -206,6 +208,8 @@ A LiDAR is either a source the command line reads (a frame folder, a cloud file,
 .bag/.mcap/rosbag2 recording, optionally followed by =NAME), or its frames: a list of N x 3 or
 N x 4 arrays (x y z [t], t in seconds from the frame's timestamp; float32 or float64, any strides;
 Open3D clouds too) with one timestamp per frame in *_times (seconds, the LiDAR's own clock).
+Arrays are not copied: each frame is read from its array when a stage asks for it, so they must
+not change during the call.
 
 target= calibrates a pair and returns a Result; targets=[...] (with target_times=[...]) a rig
 and returns a RigResult. The other keywords mirror `ulc calibrate --help`: stages, initial

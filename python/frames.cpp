@@ -3,6 +3,7 @@
 #include <pybind11/stl.h>
 
 #include <cmath>
+#include <cstring>
 
 #include "errors.hpp"
 
@@ -15,23 +16,39 @@ std::string shape_text(const py::array& a) {
   return s + (a.ndim() == 1 ? ",)" : ")");
 }
 
-/// Reads rows of a 2-D array of Scalar through its strides.
+/// Value (row, column) of the frame's buffer.
 template <class Scalar>
-PointCloud<float> read_rows(const py::array& a, const std::string& what) {
-  const auto v = a.unchecked<Scalar, 2>();
-  const py::ssize_t n = v.shape(0);
-  const bool timed = v.shape(1) == 4;
+double value_at(const ArrayFrame& f, std::size_t row, py::ssize_t column) {
+  const char* at = f.data + static_cast<py::ssize_t>(row) * f.row_stride + column * f.column_stride;
+  Scalar v;
+  std::memcpy(&v, at, sizeof v);
+  return static_cast<double>(v);
+}
+
+double value_at(const ArrayFrame& f, std::size_t row, py::ssize_t column) {
+  return f.float64 ? value_at<double>(f, row, column) : value_at<float>(f, row, column);
+}
+
+/// The first row with a non-finite value, or rows when there is none.
+std::size_t first_non_finite(const ArrayFrame& f) {
+  const py::ssize_t columns = f.timed ? 4 : 3;
+  for (std::size_t i = 0; i < f.rows; ++i)
+    for (py::ssize_t c = 0; c < columns; ++c)
+      if (!std::isfinite(value_at(f, i, c))) return i;
+  return f.rows;
+}
+
+/// The frame's rows as a cloud, its values of type Scalar.
+template <class Scalar>
+PointCloud<float> read_rows(const ArrayFrame& f) {
   PointCloud<float> cloud;
-  cloud.points.resize(static_cast<std::size_t>(n));
-  if (timed) cloud.times.resize(static_cast<std::size_t>(n));
-  for (py::ssize_t i = 0; i < n; ++i) {
-    const double x = v(i, 0), y = v(i, 1), z = v(i, 2);
-    if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z) ||
-        (timed && !std::isfinite(static_cast<double>(v(i, 3)))))
-      raise_error(what + ": row " + std::to_string(i) + " is not finite (drop NaN points first)");
-    cloud.points[static_cast<std::size_t>(i)] =
-        Eigen::Vector3f(static_cast<float>(x), static_cast<float>(y), static_cast<float>(z));
-    if (timed) cloud.times[static_cast<std::size_t>(i)] = static_cast<double>(v(i, 3));
+  cloud.points.resize(f.rows);
+  if (f.timed) cloud.times.resize(f.rows);
+  for (std::size_t i = 0; i < f.rows; ++i) {
+    cloud.points[i] = Eigen::Vector3f(static_cast<float>(value_at<Scalar>(f, i, 0)),
+                                      static_cast<float>(value_at<Scalar>(f, i, 1)),
+                                      static_cast<float>(value_at<Scalar>(f, i, 2)));
+    if (f.timed) cloud.times[i] = value_at<Scalar>(f, i, 3);
   }
   return cloud;
 }
@@ -51,7 +68,7 @@ bool is_frame_like(const py::handle& obj) {
 
 }  // namespace
 
-PointCloud<float> cloud_from_python(const py::handle& frame, const std::string& what) {
+ArrayFrame array_frame(const py::handle& frame, const std::string& what) {
   py::array a;
   try {
     a = as_array(frame);
@@ -61,16 +78,26 @@ PointCloud<float> cloud_from_python(const py::handle& frame, const std::string& 
   if (a.ndim() != 2 || (a.shape(1) != 3 && a.shape(1) != 4))
     raise_error(what + ": expected an N x 3 or N x 4 array (x y z [t]), got shape " +
                 shape_text(a));
-  if (a.dtype().is(py::dtype::of<float>())) return read_rows<float>(a, what);
-  if (a.dtype().is(py::dtype::of<double>())) return read_rows<double>(a, what);
-  raise_error(what + ": expected float32 or float64 values, got " +
-              py::str(a.dtype()).cast<std::string>());
+  ArrayFrame f;
+  f.float64 = a.dtype().is(py::dtype::of<double>());
+  if (!f.float64 && !a.dtype().is(py::dtype::of<float>()))
+    raise_error(what + ": expected float32 or float64 values, got " +
+                py::str(a.dtype()).cast<std::string>());
+  f.data = static_cast<const char*>(a.data());
+  f.rows = static_cast<std::size_t>(a.shape(0));
+  f.row_stride = a.strides(0);
+  f.column_stride = a.strides(1);
+  f.timed = a.shape(1) == 4;
+  f.array = std::move(a);
+  if (const std::size_t row = first_non_finite(f); row != f.rows)
+    raise_error(what + ": row " + std::to_string(row) + " is not finite (drop NaN points first)");
+  return f;
 }
 
-FloatFrames frames_from_python(const py::handle& frames, const std::string& what) {
-  FloatFrames out;
+std::vector<ArrayFrame> array_frames(const py::handle& frames, const std::string& what) {
+  std::vector<ArrayFrame> out;
   if (is_frame_like(frames)) {
-    out.push_back(cloud_from_python(frames, what + " frame 0"));
+    out.push_back(array_frame(frames, what + " frame 0"));
     return out;
   }
   if (!py::isinstance<py::sequence>(frames) || py::isinstance<py::str>(frames))
@@ -78,7 +105,21 @@ FloatFrames frames_from_python(const py::handle& frames, const std::string& what
   const auto list = py::reinterpret_borrow<py::sequence>(frames);
   if (list.size() == 0) raise_error(what + ": no frames");
   for (std::size_t k = 0; k < list.size(); ++k)
-    out.push_back(cloud_from_python(list[k], what + " frame " + std::to_string(k)));
+    out.push_back(array_frame(list[k], what + " frame " + std::to_string(k)));
+  return out;
+}
+
+PointCloud<float> read_frame(const ArrayFrame& f) {
+  return f.float64 ? read_rows<double>(f) : read_rows<float>(f);
+}
+
+PointCloud<float> cloud_from_python(const py::handle& frame, const std::string& what) {
+  return read_frame(array_frame(frame, what));
+}
+
+FloatFrames frames_from_python(const py::handle& frames, const std::string& what) {
+  FloatFrames out;
+  for (const ArrayFrame& f : array_frames(frames, what)) out.push_back(read_frame(f));
   return out;
 }
 

@@ -168,7 +168,7 @@ RigOptions rig_options(const CalibrateOptions& options, bool route, bool cycles,
   return r;
 }
 
-RigCalibration run_rig(const std::vector<RigLidar<FloatFrames>>& lidars, const RigOptions& options,
+RigCalibration run_rig(const std::vector<RigLidar<FrameSource>>& lidars, const RigOptions& options,
                        std::size_t threads) {
   RigCalibration rig = calibrate_in_arena(lidars, options, threads);
   require_valid(rig);

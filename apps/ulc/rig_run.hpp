@@ -64,9 +64,10 @@ LoadedRig load_rig(const RigRequest& request, const CalibrateOptions& options);
 RigOptions rig_options(const CalibrateOptions& options, bool route, bool cycles,
                        std::size_t lidar_count);
 
-/// calibrate_rig in a task arena of `threads` workers (0: TBB's default). UsageError for
-/// invalid input (names, missing frames).
-RigCalibration run_rig(const std::vector<RigLidar<FloatFrames>>& lidars, const RigOptions& options,
+/// calibrate_rig in a task arena of `threads` workers (0: TBB's default), on frames read on
+/// demand whose read errors are the caller's to check. UsageError for invalid input (names,
+/// missing frames).
+RigCalibration run_rig(const std::vector<RigLidar<FrameSource>>& lidars, const RigOptions& options,
                        std::size_t threads);
 /// The same on frames read on demand; io::IoError when a frame could not be read (it reached
 /// the stages empty, so the result is not to be trusted).
