@@ -3,6 +3,7 @@
 //
 //   bench_jeep [--repeats N] [--threads N] [--json]          (d) registration speed
 //   bench_jeep --accuracy   [--scenarios LIST] [--starts 50] [--frames 5] [--seed 1]
+//                           [--methods jeep,scan-scan,gicp]
 //   bench_jeep --separation [--scenarios LIST] [--starts 10]
 //   bench_jeep --robustness [--scenarios 64-32,64-horizon] [--starts 3] [--png DIR]
 //   bench_jeep --frames-sweep [--scenarios 64-32,64-horizon,64-tele] [--starts 5] [--png DIR]
@@ -13,8 +14,10 @@
 // (a) accuracy, the paper's protocol: the ground truth disturbed by 5 deg about a random axis
 //     and 2 m in a random direction (seeded per start), at --starts windows spread evenly along
 //     the drive; JEEP over --frames pairs from each window's first pair, scan-scan on that
-//     first pair. Success: status ok and e_rot < 1 deg and e_trans < 10 cm; a result reported
-//     ok but outside those is a false accept. Medians are over all runs.
+//     first pair, and the GICP baseline (gicp_baseline.hpp) on that same pair from the same
+//     guess (--methods picks the rows). Success: status ok (GICP: converged) and e_rot < 1 deg
+//     and e_trans < 10 cm; a result reported ok but outside those is a false accept. Medians
+//     are over all runs.
 // separation: the acceptance rule's evidence (overlap, directional and off-ground overlap,
 //     condition) for the true data and for unrelated data (b's frames from the other half of
 //     the drive, relabelled in time).
@@ -42,6 +45,7 @@
 #include <vector>
 
 #include "../tests/jeep/jeep_test_util.hpp"
+#include "gicp_baseline.hpp"
 #include "jeep/jeep.hpp"
 #include "jeep/scan_scan.hpp"
 #include "odometry/run_odometry.hpp"
@@ -69,6 +73,7 @@ struct Config {
   std::string cache = "/tmp/ulc_jeep_cache";
   std::string png_dir;   ///< --png DIR: robustness and frames-sweep heat maps as PNG
   bool one_way = false;  ///< --one-way: JEEP without the two-way step
+  std::vector<std::string> methods = {"jeep", "scan-scan", "gicp"};  ///< --accuracy's rows
   ulc_bench::Options bench;
 };
 
@@ -229,6 +234,31 @@ Outcome run_scan_scan(const Drive& d, std::size_t pair, const Isometry3d& initia
   return out;
 }
 
+/// The GICP baseline on the scan-scan pair from the same guess: target = the base LiDAR's frame
+/// (a), source = the target LiDAR's (b), so its pose is C = T_base_target. Both frames cropped
+/// to scan-scan's ranges (2-100 m) and voxel-downsampled to its 0.25 m; the time includes that.
+constexpr double kGicpVoxel = 0.25;  ///< m
+
+Outcome run_gicp(const Drive& d, std::size_t pair, const Isometry3d& initial, int threads) {
+  Outcome out;
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto r = in_arena(threads, [&] {
+    const auto target = gicp_baseline::prepare(d.a().frames[d.pairs[pair].a], kGicpVoxel);
+    const auto source = gicp_baseline::prepare(d.b().frames[d.pairs[pair].b], kGicpVoxel);
+    return gicp_baseline::gicp(source, target, initial);
+  });
+  out.seconds = seconds_since(t0);
+  out.ok = r.converged;
+  out.status = r.converged ? "ok" : "not_converged";
+  out.error = ulc::pose_error(d.truth, r.pose);
+  out.rounds = r.iterations;
+  return out;
+}
+
+bool wanted(const Config& c, const std::string& method) {
+  return std::find(c.methods.begin(), c.methods.end(), method) != c.methods.end();
+}
+
 void emit(const ulc_bench::Table& table, const std::string& name, const Config& c,
           const std::vector<std::pair<std::string, Cell>>& parameters,
           const std::vector<std::pair<std::string, Cell>>& notes = {}) {
@@ -254,26 +284,39 @@ void accuracy(Config c) {
   const jeep::JeepOptions o = jeep_options(c, c.frames);
   for (const auto& scenario : c.scenarios) {
     const Drive d = load_drive(scenario, c);
-    Summary jeep_summary, scan_summary;
+    Summary jeep_summary, scan_summary, gicp_summary;
     for (std::size_t s : start_pairs(d, c.starts, c.frames)) {
       const Isometry3d initial = disturbance_for(d, c, s, 5.0, 2.0);
-      const Outcome j = run_jeep(window(d, s, c.frames), initial, d.truth, o, c.threads);
-      jeep_summary.add(j);
-      scan_summary.add(run_scan_scan(d, s, initial, c.threads));
-      if (!c.bench.json)
-        std::cerr << "  " << scenario << " start " << s << ": jeep " << j.status << " after "
-                  << j.rounds << " rounds, e_rot " << j.error.rotation_deg << " e_trans "
-                  << j.error.translation_m << ", overlap " << j.overlap << ", condition "
-                  << j.condition << " (" << j.seconds << " s)\n";
+      if (wanted(c, "jeep")) {
+        const Outcome j = run_jeep(window(d, s, c.frames), initial, d.truth, o, c.threads);
+        jeep_summary.add(j);
+        if (!c.bench.json)
+          std::cerr << "  " << scenario << " start " << s << ": jeep " << j.status << " after "
+                    << j.rounds << " rounds, e_rot " << j.error.rotation_deg << " e_trans "
+                    << j.error.translation_m << ", overlap " << j.overlap << ", condition "
+                    << j.condition << " (" << j.seconds << " s)\n";
+      }
+      if (wanted(c, "scan-scan")) scan_summary.add(run_scan_scan(d, s, initial, c.threads));
+      if (wanted(c, "gicp")) {
+        const Outcome g = run_gicp(d, s, initial, c.threads);
+        gicp_summary.add(g);
+        if (!c.bench.json)
+          std::cerr << "  " << scenario << " start " << s << ": gicp " << g.status << " after "
+                    << g.rounds << " iterations, e_rot " << g.error.rotation_deg << " e_trans "
+                    << g.error.translation_m << " (" << g.seconds << " s)\n";
+      }
     }
-    for (const auto* sum : {&jeep_summary, &scan_summary}) {
+    for (const auto* sum : {&jeep_summary, &scan_summary, &gicp_summary}) {
+      const char* method = sum == &jeep_summary   ? "jeep"
+                           : sum == &scan_summary ? "scan-scan"
+                                                  : "gicp";
+      if (!wanted(c, method)) continue;
       auto p90 = [](std::vector<double> v) {
         if (v.empty()) return 0.0;
         std::sort(v.begin(), v.end());
         return v[static_cast<std::size_t>(0.9 * (v.size() - 1))];
       };
-      table.add_row({scenario, sum == &jeep_summary ? "jeep" : "scan-scan",
-                     Cell::integer(static_cast<long long>(sum->runs)),
+      table.add_row({scenario, method, Cell::integer(static_cast<long long>(sum->runs)),
                      Cell::num(sum->pct(sum->successes), 1), Cell::num(sum->pct(sum->accepted), 1),
                      Cell::integer(static_cast<long long>(sum->false_accepts)),
                      Cell::num(jeep_test::median(sum->rot), 4),
@@ -292,6 +335,10 @@ void accuracy(Config c) {
         {"threads", Cell::integer(c.threads)},
         {"disturbance", "5 deg about a random axis, 2 m in a random direction"}},
        {{"success", "status ok and e_rot < 1 deg and e_trans < 10 cm"},
+        {"gicp",
+         "plane-to-plane Generalized-ICP (Segal et al. 2009, bench/gicp_baseline.hpp) on the "
+         "scan-scan pair from the same guess, 0.25 m voxels, gates 4/1.5/0.6/0.3 m; ok = "
+         "converged"},
         {"medians", "over all runs, failures included"}});
 }
 
@@ -649,6 +696,10 @@ int main(int argc, char** argv) {
   app.add_option("--png", c.png_dir, "robustness and frames-sweep heat maps as PNG")
       ->type_name("DIR");
   app.add_flag("--one-way", c.one_way, "JEEP without its two-way step");
+  app.add_option("--methods", c.methods, "--accuracy's rows (default jeep,scan-scan,gicp)")
+      ->delimiter(',')
+      ->type_name("A,B,...")
+      ->check(CLI::IsMember({"jeep", "scan-scan", "gicp"}));
   CLI11_PARSE(app, argc, argv);
   const bool repeats_given = app.count("--repeats") > 0;
   if (c.mode == "accuracy") {
