@@ -11,7 +11,7 @@
 //     steady the poses (10 s drives: 32-avia seed 2 uncertain, 32-mid40 seed 1 0.012 -> 0.032
 //     deg; docs/experiments/hots_base_odometry.md).
 //   - Rule: base when the base's frames from frame_index last at least min_duration_s seconds
-//     (their span and one mean frame period: 300 frames at 10 Hz last 30 s) and the base sees
+//     (their span and one frame period: 300 frames at 10 Hz last 30 s) and the base sees
 //     all around, else joint. min_duration_s = 30 s: on the paper's pairs with a
 //     360-degree base, 30 s and 60 s drives gave the same answers with either odometry
 //     (docs/experiments/hots_base_odometry.md, "Longer drives").
@@ -37,6 +37,7 @@
 #include <string>
 #include <vector>
 
+#include "odometry/frame_pairing.hpp"
 #include "pipeline/options.hpp"
 #include "ulc/core/point_traits.hpp"
 
@@ -79,12 +80,11 @@ double azimuth_coverage(const Cloud& cloud, const OdometryChoiceOptions& options
   return count / static_cast<double>(sectors);
 }
 
-/// How long frames at these timestamps last: their span and one mean frame period (0 for fewer
-/// than two).
+/// How long frames at these timestamps last: their span and one frame period
+/// (odometry::frame_period, the median gap; 0 for fewer than two).
 inline double recorded_duration(const std::vector<double>& times) {
   if (times.size() < 2) return 0.0;
-  const double span = times.back() - times.front();
-  return span + span / static_cast<double>(times.size() - 1);
+  return times.back() - times.front() + odometry::frame_period(times);
 }
 
 /// The median coverage of the first, middle and last frame of `frames` (0 with none).
