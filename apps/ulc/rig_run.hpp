@@ -69,8 +69,8 @@ RigOptions rig_options(const CalibrateOptions& options, bool route, bool cycles,
 /// missing frames).
 RigCalibration run_rig(const std::vector<RigLidar<FrameSource>>& lidars, const RigOptions& options,
                        std::size_t threads);
-/// The same on frames read on demand; io::IoError when a frame could not be read (it reached
-/// the stages empty, so the result is not to be trusted).
+/// The same on the loaded sources, whose read errors it checks: io::IoError when a frame could
+/// not be read (it reached the stages empty, so the result is not to be trusted).
 RigCalibration run_rig(const LoadedRig& loaded, const RigOptions& options, std::size_t threads);
 
 /// The result file's entries of a rig: one per target, in input order, and one per cycle.
