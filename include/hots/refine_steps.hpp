@@ -565,9 +565,12 @@ bool sequence_step(RefineState<S>& s, const RefineOptions& options, RefineResult
     // sample of that disagreement, and a rerun from refine's own start another: each added as
     // a rank-one term (hots.hpp). When the step adopted a new clock offset, the graph's C was
     // solved at the old one and the move is mostly the offset's change times the speed (60 s
-    // 64-32 drive, target 50 ms late: the synchronisation's 30.3 ms left the graph's C 12.5 cm
-    // along the drive from the step's, which found 49.9 ms and lies 0.7 mm from the truth; as
-    // a term it made sigma 12.3 cm and the result uncertain). The rerun, solved at the step's
+    // 64-32 drive, target 50 ms late: the synchronisation's 27.7 ms left its C 14 cm along the
+    // drive from the step's, which found 49.8 ms and lies 1.9 mm from the truth). Nor does the
+    // graph give a clean sample at the new offset: its cross links were registered at the old
+    // one, and re-solved there (or the synchronisation's mean taken there, or the change taken
+    // out by dC/ddt) it still lies 1.0-1.7 cm from the step, which would make sigma 5-9x the
+    // error (docs/experiments/graph_move_after_offset.md). The rerun, solved at the step's
     // offset, is then the only sample besides the step's own term for the offset's error
     // (sequence_extrinsic.hpp, offset_error_term).
     const Vec6d moved = st.sequence.time_offset_refined
