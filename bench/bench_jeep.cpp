@@ -1,9 +1,10 @@
-// bench_jeep: JEEP, the scan-scan baseline, multi-LiDAR odometry and point-to-plane ICP on
-// simulated rig drives (ulc::sim; the 20 s drives are cached under --cache, /tmp by default).
+// bench_jeep: JEEP, the scan-scan, GICP and NDT baselines, multi-LiDAR odometry and
+// point-to-plane ICP on simulated rig drives (ulc::sim; the 20 s drives are cached under --cache,
+// /tmp by default).
 //
 //   bench_jeep [--repeats N] [--threads N] [--json]          (d) registration speed
 //   bench_jeep --accuracy   [--scenarios LIST] [--starts 50] [--frames 5] [--seed 1]
-//                           [--methods jeep,scan-scan,gicp]
+//                           [--methods jeep,scan-scan,gicp,ndt]
 //   bench_jeep --separation [--scenarios LIST] [--starts 10]
 //   bench_jeep --robustness [--scenarios 64-32,64-horizon] [--starts 3] [--png DIR]
 //   bench_jeep --frames-sweep [--scenarios 64-32,64-horizon,64-tele] [--starts 5] [--png DIR]
@@ -14,10 +15,11 @@
 // (a) accuracy, the paper's protocol: the ground truth disturbed by 5 deg about a random axis
 //     and 2 m in a random direction (seeded per start), at --starts windows spread evenly along
 //     the drive; JEEP over --frames pairs from each window's first pair, scan-scan on that
-//     first pair, and the GICP baseline (gicp_baseline.hpp) on that same pair from the same
-//     guess (--methods picks the rows). Success: status ok (GICP: converged) and e_rot < 1 deg
-//     and e_trans < 10 cm; a result reported ok but outside those is a false accept. Medians
-//     are over all runs.
+//     first pair, and the GICP and NDT baselines (gicp_baseline.hpp, ndt_baseline.hpp) on that
+//     same pair from the same guess, its frames prepared as scan-scan prepares them (--methods
+//     picks the rows). Success: status ok (GICP, NDT: converged) and e_rot < 1 deg and
+//     e_trans < 10 cm; a result reported ok but outside those is a false accept. Medians are
+//     over all runs.
 // separation: the acceptance rule's evidence (overlap, directional and off-ground overlap,
 //     condition) for the true data and for unrelated data (b's frames from the other half of
 //     the drive, relabelled in time).
@@ -42,12 +44,14 @@
 #include <random>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "../tests/jeep/jeep_test_util.hpp"
 #include "gicp_baseline.hpp"
 #include "jeep/jeep.hpp"
 #include "jeep/scan_scan.hpp"
+#include "ndt_baseline.hpp"
 #include "odometry/run_odometry.hpp"
 #include "support/bench_util.hpp"
 #include "support/heatmap_png.hpp"
@@ -73,7 +77,7 @@ struct Config {
   std::string cache = "/tmp/ulc_jeep_cache";
   std::string png_dir;   ///< --png DIR: robustness and frames-sweep heat maps as PNG
   bool one_way = false;  ///< --one-way: JEEP without the two-way step
-  std::vector<std::string> methods = {"jeep", "scan-scan", "gicp"};  ///< --accuracy's rows
+  std::vector<std::string> methods = {"jeep", "scan-scan", "gicp", "ndt"};  ///< --accuracy's rows
   ulc_bench::Options bench;
 };
 
@@ -234,18 +238,30 @@ Outcome run_scan_scan(const Drive& d, std::size_t pair, const Isometry3d& initia
   return out;
 }
 
-/// The GICP baseline on the scan-scan pair from the same guess: target = the base LiDAR's frame
-/// (a), source = the target LiDAR's (b), so its pose is C = T_base_target. Both frames cropped
-/// to scan-scan's ranges (2-100 m) and voxel-downsampled to its 0.25 m; the time includes that.
-constexpr double kGicpVoxel = 0.25;  ///< m
+/// A frame as scan-scan prepares it (jeep/scan_scan.hpp): odometry::prepare_scan with
+/// jeep::ScanScanOptions' scan options (2-100 m, 0.25 m voxel centroids, no deskew), its dense
+/// points (the ones scan-scan registers), in double for the refinement baselines.
+std::vector<ulc::Vec3d> scan_scan_points(const ulc::PointCloud<float>& frame) {
+  const jeep::ScanScanOptions o;
+  const auto scan = odometry::prepare_scan<float>(frame, ulc::Vec6d::Zero(), 0.0, o.scan);
+  std::vector<ulc::Vec3d> out;
+  out.reserve(scan.dense.size());
+  for (const auto& p : scan.dense) out.push_back(p.cast<double>());
+  return out;
+}
 
-Outcome run_gicp(const Drive& d, std::size_t pair, const Isometry3d& initial, int threads) {
+/// A refinement baseline on the scan-scan pair from the same guess: target = the base LiDAR's
+/// frame (a), source = the target LiDAR's (b), so its pose is C = T_base_target; `refine(source,
+/// target)` returns the baseline's result. Frames prepared by scan_scan_points; the time
+/// includes that. ok = converged.
+template <class Refine>
+Outcome run_baseline(const Drive& d, std::size_t pair, int threads, Refine&& refine) {
   Outcome out;
   const auto t0 = std::chrono::steady_clock::now();
   const auto r = in_arena(threads, [&] {
-    const auto target = gicp_baseline::prepare(d.a().frames[d.pairs[pair].a], kGicpVoxel);
-    const auto source = gicp_baseline::prepare(d.b().frames[d.pairs[pair].b], kGicpVoxel);
-    return gicp_baseline::gicp(source, target, initial);
+    const auto target = scan_scan_points(d.a().frames[d.pairs[pair].a]);
+    const auto source = scan_scan_points(d.b().frames[d.pairs[pair].b]);
+    return refine(source, target);
   });
   out.seconds = seconds_since(t0);
   out.ok = r.converged;
@@ -255,8 +271,16 @@ Outcome run_gicp(const Drive& d, std::size_t pair, const Isometry3d& initial, in
   return out;
 }
 
-bool wanted(const Config& c, const std::string& method) {
-  return std::find(c.methods.begin(), c.methods.end(), method) != c.methods.end();
+Outcome run_gicp(const Drive& d, std::size_t pair, const Isometry3d& initial, int threads) {
+  return run_baseline(d, pair, threads, [&](const auto& source, const auto& target) {
+    return gicp_baseline::gicp(source, target, initial);
+  });
+}
+
+Outcome run_ndt(const Drive& d, std::size_t pair, const Isometry3d& initial, int threads) {
+  return run_baseline(d, pair, threads, [&](const auto& source, const auto& target) {
+    return ndt_baseline::ndt(source, target, initial);
+  });
 }
 
 void emit(const ulc_bench::Table& table, const std::string& name, const Config& c,
@@ -274,6 +298,26 @@ std::string scenario_list(const Config& c) {
 // ---------------------------------------------------------------------------------------------
 // (a) accuracy
 
+/// One --accuracy run of `method` from start pair s: JEEP over the window, the others on its
+/// first pair.
+Outcome run_method(const std::string& method, const Drive& d, std::size_t s,
+                   const Isometry3d& initial, const jeep::JeepOptions& o, const Config& c) {
+  if (method == "jeep") return run_jeep(window(d, s, c.frames), initial, d.truth, o, c.threads);
+  if (method == "scan-scan") return run_scan_scan(d, s, initial, c.threads);
+  if (method == "gicp") return run_gicp(d, s, initial, c.threads);
+  return run_ndt(d, s, initial, c.threads);
+}
+
+/// One run's line on stderr (JEEP's with its acceptance evidence).
+void log_run(const std::string& scenario, std::size_t s, const std::string& method,
+             const Outcome& r) {
+  std::cerr << "  " << scenario << " start " << s << ": " << method << " " << r.status << " after "
+            << r.rounds << (method == "jeep" ? " rounds" : " iterations") << ", e_rot "
+            << r.error.rotation_deg << " e_trans " << r.error.translation_m;
+  if (method == "jeep") std::cerr << ", overlap " << r.overlap << ", condition " << r.condition;
+  std::cerr << " (" << r.seconds << " s)\n";
+}
+
 void accuracy(Config c) {
   if (c.scenarios.empty())
     c.scenarios = {"64-32", "32-16", "horizon-tele", "64-horizon", "32-avia", "64-tele"};
@@ -284,46 +328,31 @@ void accuracy(Config c) {
   const jeep::JeepOptions o = jeep_options(c, c.frames);
   for (const auto& scenario : c.scenarios) {
     const Drive d = load_drive(scenario, c);
-    Summary jeep_summary, scan_summary, gicp_summary;
+    // One summary per method, in --methods order: the table's rows.
+    std::vector<std::pair<std::string, Summary>> summaries;
+    for (const auto& method : c.methods) summaries.emplace_back(method, Summary{});
     for (std::size_t s : start_pairs(d, c.starts, c.frames)) {
       const Isometry3d initial = disturbance_for(d, c, s, 5.0, 2.0);
-      if (wanted(c, "jeep")) {
-        const Outcome j = run_jeep(window(d, s, c.frames), initial, d.truth, o, c.threads);
-        jeep_summary.add(j);
-        if (!c.bench.json)
-          std::cerr << "  " << scenario << " start " << s << ": jeep " << j.status << " after "
-                    << j.rounds << " rounds, e_rot " << j.error.rotation_deg << " e_trans "
-                    << j.error.translation_m << ", overlap " << j.overlap << ", condition "
-                    << j.condition << " (" << j.seconds << " s)\n";
-      }
-      if (wanted(c, "scan-scan")) scan_summary.add(run_scan_scan(d, s, initial, c.threads));
-      if (wanted(c, "gicp")) {
-        const Outcome g = run_gicp(d, s, initial, c.threads);
-        gicp_summary.add(g);
-        if (!c.bench.json)
-          std::cerr << "  " << scenario << " start " << s << ": gicp " << g.status << " after "
-                    << g.rounds << " iterations, e_rot " << g.error.rotation_deg << " e_trans "
-                    << g.error.translation_m << " (" << g.seconds << " s)\n";
+      for (auto& [method, summary] : summaries) {
+        const Outcome r = run_method(method, d, s, initial, o, c);
+        summary.add(r);
+        if (!c.bench.json && method != "scan-scan") log_run(scenario, s, method, r);
       }
     }
-    for (const auto* sum : {&jeep_summary, &scan_summary, &gicp_summary}) {
-      const char* method = sum == &jeep_summary   ? "jeep"
-                           : sum == &scan_summary ? "scan-scan"
-                                                  : "gicp";
-      if (!wanted(c, method)) continue;
+    for (const auto& [method, sum] : summaries) {
       auto p90 = [](std::vector<double> v) {
         if (v.empty()) return 0.0;
         std::sort(v.begin(), v.end());
         return v[static_cast<std::size_t>(0.9 * (v.size() - 1))];
       };
-      table.add_row({scenario, method, Cell::integer(static_cast<long long>(sum->runs)),
-                     Cell::num(sum->pct(sum->successes), 1), Cell::num(sum->pct(sum->accepted), 1),
-                     Cell::integer(static_cast<long long>(sum->false_accepts)),
-                     Cell::num(jeep_test::median(sum->rot), 4),
-                     Cell::num(100 * jeep_test::median(sum->trans), 2), Cell::num(p90(sum->rot), 4),
-                     Cell::num(100 * p90(sum->trans), 2),
-                     Cell::num(sum == &jeep_summary ? jeep_test::median(sum->rounds) : 0.0, 1),
-                     Cell::num(jeep_test::median(sum->time), 3)});
+      table.add_row({scenario, method, Cell::integer(static_cast<long long>(sum.runs)),
+                     Cell::num(sum.pct(sum.successes), 1), Cell::num(sum.pct(sum.accepted), 1),
+                     Cell::integer(static_cast<long long>(sum.false_accepts)),
+                     Cell::num(jeep_test::median(sum.rot), 4),
+                     Cell::num(100 * jeep_test::median(sum.trans), 2), Cell::num(p90(sum.rot), 4),
+                     Cell::num(100 * p90(sum.trans), 2),
+                     Cell::num(method == "jeep" ? jeep_test::median(sum.rounds) : 0.0, 1),
+                     Cell::num(jeep_test::median(sum.time), 3)});
     }
   }
   emit(table, "bench_jeep_accuracy", c,
@@ -337,8 +366,12 @@ void accuracy(Config c) {
        {{"success", "status ok and e_rot < 1 deg and e_trans < 10 cm"},
         {"gicp",
          "plane-to-plane Generalized-ICP (Segal et al. 2009, bench/gicp_baseline.hpp) on the "
-         "scan-scan pair from the same guess, 0.25 m voxels, gates 4/1.5/0.6/0.3 m; ok = "
-         "converged"},
+         "scan-scan pair from the same guess, frames prepared as scan-scan's (2-100 m, 0.25 m "
+         "voxels), gates 4/1.5/0.6/0.3 m; ok = converged"},
+        {"ndt",
+         "point-to-distribution NDT (Magnusson 2009, bench/ndt_baseline.hpp) on the scan-scan "
+         "pair from the same guess, frames prepared as scan-scan's, cells 4/2/1 m, each point "
+         "scored against its cell and the six face neighbours; ok = converged"},
         {"medians", "over all runs, failures included"}});
 }
 
@@ -696,10 +729,11 @@ int main(int argc, char** argv) {
   app.add_option("--png", c.png_dir, "robustness and frames-sweep heat maps as PNG")
       ->type_name("DIR");
   app.add_flag("--one-way", c.one_way, "JEEP without its two-way step");
-  app.add_option("--methods", c.methods, "--accuracy's rows (default jeep,scan-scan,gicp)")
+  app.add_option("--methods", c.methods,
+                 "--accuracy's rows, in this order (default jeep,scan-scan,gicp,ndt)")
       ->delimiter(',')
       ->type_name("A,B,...")
-      ->check(CLI::IsMember({"jeep", "scan-scan", "gicp"}));
+      ->check(CLI::IsMember({"jeep", "scan-scan", "gicp", "ndt"}));
   CLI11_PARSE(app, argc, argv);
   const bool repeats_given = app.count("--repeats") > 0;
   if (c.mode == "accuracy") {

@@ -1,11 +1,15 @@
 // A refinement baseline for the refinement table: Generalized-ICP (Segal, Haehnel and Thrun,
 // "Generalized-ICP", RSS 2009) in its plane-to-plane form, written for bench_jeep only (the
 // library has no GICP; PCL and Open3D are not dependencies). What it does:
+//   - the caller prepares both clouds (bench_jeep: as scan-scan does, odometry::prepare_scan with
+//     jeep::ScanScanOptions' scan options, so the baselines on one frame pair see the same points);
 //   - every point of both clouds gets a covariance from its k nearest neighbours in its own
 //     cloud (k = 20), regularised as the paper's plane-to-plane model:
-//     C = V diag(eps, 1, 1) V^T, V the neighbourhood's eigenvectors (smallest eigenvalue
-//     first), eps = 1e-3: each point is a small disc on its local plane, certain along the
-//     normal and uncertain within the plane;
+//     C = I - (1 - eps) n n^T, n the neighbourhood's normal (ulc::estimate_normals: the
+//     eigenvector of the smallest eigenvalue), eps = 1e-3: each point is a small disc on its
+//     local plane, certain along the normal and uncertain within the plane. This is the paper's
+//     V diag(eps, 1, 1) V^T written with the normal alone (V's other two columns span the plane);
+//     a neighbourhood with no plane (fewer than 3 points, coincident or collinear) is isotropic;
 //   - each iteration re-matches every source point a_i, moved by the current T, to its nearest
 //     target point b_i within the stage's correspondence distance, and minimises the paper's
 //     maximum-likelihood objective sum_i d_i^T (C_b_i + R C_a_i R^T)^-1 d_i with d_i = b_i - T a_i,
@@ -15,7 +19,8 @@
 //     of scan-scan's and JEEP's registration stages, jeep/options.hpp, so the two baselines on
 //     one frame pair differ in their cost, not in how far they look for partners);
 //   - a stage ends when an update moves T by less than the tolerances or after max_iterations;
-//     the result is converged when the last stage ended on a small update with enough matches.
+//     the result is converged when the last stage ended on a small update (which needs enough
+//     matches in that iteration).
 // Conventions: the library's (ulc/core/lie.hpp), a left perturbation T <- exp(xi) T with
 // xi = [rho; phi]; the pose is T_target_source (p_target = T * p_source). No randomness; the
 // per-point searches run in parallel but every sum is taken in point order: the same input
@@ -26,7 +31,6 @@
 #include <tbb/parallel_for.h>
 
 #include <Eigen/Cholesky>
-#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
@@ -36,8 +40,8 @@
 
 #include "ulc/core/kdtree.hpp"
 #include "ulc/core/lie.hpp"
+#include "ulc/core/normals.hpp"
 #include "ulc/core/types.hpp"
-#include "ulc/core/voxel_downsample.hpp"
 
 namespace gicp_baseline {
 
@@ -66,20 +70,6 @@ struct Result {
   double cost = 0.0;                         ///< the objective over them, at the returned pose
 };
 
-/// A cloud as GICP takes it: the points within [min_range, max_range] of the sensor (the
-/// origin), voxel-downsampled (one centroid per voxel).
-template <class Cloud>
-Points prepare(const Cloud& cloud, double voxel, double min_range = 2.0, double max_range = 100.0) {
-  Points cropped;
-  for (const auto& p : cloud.points) {
-    const Vec3d q = p.template cast<double>();
-    const double r = q.norm();
-    if (r >= min_range && r <= max_range) cropped.push_back(q);
-  }
-  const auto thinned = ulc::voxel_downsample(cropped, voxel);
-  return Points(thinned.cloud.points.begin(), thinned.cloud.points.end());
-}
-
 namespace detail {
 
 /// One correspondence: source point i, target point j.
@@ -87,35 +77,24 @@ struct Match {
   std::size_t i, j;
 };
 
-/// The plane-to-plane covariance of a neighbourhood (Segal et al.): the sample
-/// covariance's eigenvectors kept, its eigenvalues replaced by (eps, 1, 1).
-inline Mat3d plane_covariance(const Points& points, const std::vector<std::size_t>& near,
-                              double epsilon) {
-  if (near.size() < 3) return Mat3d::Identity();  // no plane to speak of: isotropic
-  Vec3d mean = Vec3d::Zero();
-  for (std::size_t k : near) mean += points[k];
-  mean /= static_cast<double>(near.size());
-  Mat3d scatter = Mat3d::Zero();
-  for (std::size_t k : near) scatter += (points[k] - mean) * (points[k] - mean).transpose();
-  const Eigen::SelfAdjointEigenSolver<Mat3d> eig(scatter);  // eigenvalues ascending
-  const Mat3d& V = eig.eigenvectors();
-  return V * Vec3d(epsilon, 1.0, 1.0).asDiagonal() * V.transpose();
+/// The plane-to-plane covariance of a point with unit normal n (Segal et al.):
+/// I - (1 - eps) n n^T, variance eps along the normal and 1 within the plane.
+inline Mat3d plane_covariance(const Vec3d& normal, double epsilon) {
+  return Mat3d::Identity() - (1.0 - epsilon) * normal * normal.transpose();
 }
 
-/// Every point's covariance from its k nearest neighbours in its own cloud (itself included).
-/// Each point's result depends on nothing else, so threads do not change it.
+/// Every point's covariance from the normal of its k nearest neighbours in its own cloud (itself
+/// included); isotropic where estimate_normals finds no plane. Each point's result depends on
+/// nothing else, so threads do not change it.
 inline std::vector<Mat3d> covariances(const Points& points, const ulc::KdTree<Points>& tree,
                                       const Options& o) {
-  std::vector<Mat3d> out(points.size());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, points.size(), 1024),
-                    [&](const tbb::blocked_range<std::size_t>& range) {
-                      std::vector<std::size_t> near;
-                      std::vector<double> sq;
-                      for (std::size_t i = range.begin(); i != range.end(); ++i) {
-                        tree.knn(points[i], o.covariance_neighbours, near, sq);
-                        out[i] = plane_covariance(points, near, o.epsilon);
-                      }
-                    });
+  ulc::NormalEstimationOptions normal_options;
+  normal_options.k = o.covariance_neighbours;
+  const auto normals = ulc::estimate_normals(points, tree, normal_options);
+  std::vector<Mat3d> out(points.size(), Mat3d::Identity());
+  if (!normals.ok()) return out;
+  for (std::size_t i = 0; i < points.size(); ++i)
+    if (normals.points[i].valid) out[i] = plane_covariance(normals.points[i].normal, o.epsilon);
   return out;
 }
 
@@ -230,8 +209,8 @@ inline bool run_stage(const Points& source, const Points& target,
 
 }  // namespace detail
 
-/// GICP of `source` onto `target` from `initial` (both clouds prepared by the caller, e.g. by
-/// prepare() above): the pose T_target_source.
+/// GICP of `source` onto `target` from `initial` (both clouds prepared by the caller): the pose
+/// T_target_source.
 inline Result gicp(const Points& source, const Points& target, const Isometry3d& initial,
                    const Options& o = {}) {
   Result r;
@@ -242,10 +221,9 @@ inline Result gicp(const Points& source, const Points& target, const Isometry3d&
   const ulc::KdTree<Points> source_tree(source), target_tree(target);
   const auto source_cov = detail::covariances(source, source_tree, o);
   const auto target_cov = detail::covariances(target, target_tree, o);
-  bool settled = false;
   for (double gate : o.gates)
-    settled = detail::run_stage(source, target, target_tree, source_cov, target_cov, gate, o, r);
-  r.converged = settled && r.correspondences >= o.min_correspondences;
+    r.converged =
+        detail::run_stage(source, target, target_tree, source_cov, target_cov, gate, o, r);
   return r;
 }
 
