@@ -186,6 +186,8 @@ def experiments(images):
         "terra-landscape": existing([["bench_terra", "--landscape", "--samples", "5", "--png",
                                       images]]),
         "jeep-refine": existing([["bench_jeep", "--accuracy", "--starts", "50", "--threads", "2"]]),
+        "colorful-120s": existing([["bench_rig", "--scenarios", "colorful", "--seconds", "120",
+                                    "--no-cycles", "--threads", "2"]]),
         "jeep-maps": existing([["bench_jeep", "--robustness", "--threads", "2", "--png", images]]),
         "jeep-frames": existing([["bench_jeep", "--frames-sweep", "--threads", "2", "--png",
                                   images]]),
