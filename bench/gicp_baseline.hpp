@@ -160,11 +160,18 @@ inline void normal_equations(const Points& source, const Points& target,
   }
 }
 
+/// A step's update and the objective at the pose it leaves.
+struct Step {
+  Vec6d xi;
+  double cost;
+};
+
 /// One Levenberg-Marquardt step over fixed matches and weights: the damping grows until the
-/// step lowers the objective (and shrinks after a success). Returns the update taken: zero when no
-/// step lowers the cost (a minimum for these matches), NaN when the equations are singular.
-inline Vec6d lm_step(const Points& source, const Points& target, const std::vector<Match>& matches,
-                     const std::vector<Mat3d>& W, Isometry3d& T, double& lambda) {
+/// step lowers the objective (and shrinks after a success). Returns the update taken (zero when
+/// no step lowers the cost: a minimum for these matches; NaN when the equations are singular)
+/// and the cost at the resulting T.
+inline Step lm_step(const Points& source, const Points& target, const std::vector<Match>& matches,
+                    const std::vector<Mat3d>& W, Isometry3d& T, double& lambda) {
   Mat6d H;
   Vec6d g;
   normal_equations(source, target, matches, W, T, H, g);
@@ -173,16 +180,17 @@ inline Vec6d lm_step(const Points& source, const Points& target, const std::vect
     Mat6d damped = H;
     damped.diagonal() += lambda * H.diagonal();
     const Vec6d xi = damped.ldlt().solve(-g);
-    if (!xi.allFinite()) return Vec6d::Constant(std::numeric_limits<double>::quiet_NaN());
+    if (!xi.allFinite()) return {Vec6d::Constant(std::numeric_limits<double>::quiet_NaN()), before};
     const Isometry3d candidate = ulc::se3_exp(xi) * T;
-    if (cost(source, target, matches, W, candidate) <= before) {
+    const double after = cost(source, target, matches, W, candidate);
+    if (after <= before) {
       T = candidate;
       lambda = std::max(lambda / 10.0, 1e-9);
-      return xi;
+      return {xi, after};
     }
     lambda *= 10.0;
   }
-  return Vec6d::Zero();
+  return {Vec6d::Zero(), before};
 }
 
 /// Iterations of one stage (one gate). True when it ended on a small update; false after
@@ -198,9 +206,9 @@ inline bool run_stage(const Points& source, const Points& target,
     if (matches.size() < o.min_correspondences) return false;
     const auto W = information(matches, source_cov, target_cov, r.pose.linear());
     ++r.iterations;
-    const Vec6d xi = lm_step(source, target, matches, W, r.pose, lambda);
+    const auto [xi, cost_after] = lm_step(source, target, matches, W, r.pose, lambda);
     if (!xi.allFinite()) return false;
-    r.cost = cost(source, target, matches, W, r.pose);
+    r.cost = cost_after;
     if (xi.head<3>().norm() < o.translation_tolerance && xi.tail<3>().norm() < o.rotation_tolerance)
       return true;
   }

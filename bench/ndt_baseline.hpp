@@ -288,11 +288,18 @@ inline void derivatives(const Points& source, const Grid& grid,
 
 namespace detail {
 
+/// A step's update and the score at the pose it leaves.
+struct Step {
+  Vec6d xi;
+  double score;
+};
+
 /// One damped Newton step over held cells: the damping grows until H + lambda diag(|H|) is
 /// positive definite and the step lowers the score (and shrinks after a success). Returns the
-/// update taken: zero when no step lowers the score (a minimum for these cells).
-inline Vec6d newton_step(const Points& source, const Grid& grid, const std::vector<CellList>& cells,
-                         const ScoreConstants& k, Isometry3d& T, double& lambda) {
+/// update taken (zero when no step lowers the score: a minimum for these cells) and the score at
+/// the resulting T.
+inline Step newton_step(const Points& source, const Grid& grid, const std::vector<CellList>& cells,
+                        const ScoreConstants& k, Isometry3d& T, double& lambda) {
   Vec6d g;
   Mat6d H;
   derivatives(source, grid, cells, T, k, g, H);
@@ -307,15 +314,16 @@ inline Vec6d newton_step(const Points& source, const Grid& grid, const std::vect
     if (llt.info() == Eigen::Success) {
       const Vec6d xi = llt.solve(-g);
       const Isometry3d candidate = ulc::se3_exp(xi) * T;
-      if (xi.allFinite() && score(source, grid, cells, candidate, k) <= before) {
+      const double after = xi.allFinite() ? score(source, grid, cells, candidate, k) : before;
+      if (xi.allFinite() && after <= before) {
         T = candidate;
         lambda = std::max(lambda / 10.0, 1e-9);
-        return xi;
+        return {xi, after};
       }
     }
     lambda *= 10.0;
   }
-  return Vec6d::Zero();
+  return {Vec6d::Zero(), before};
 }
 
 /// Iterations of one stage (one grid). True when it ended on a small update; false after
@@ -328,8 +336,8 @@ inline bool run_stage(const Points& source, const Grid& grid, const Options& o, 
     r.scored = count_scored(cells);
     if (r.scored < o.min_scored) return false;
     ++r.iterations;
-    const Vec6d xi = newton_step(source, grid, cells, k, r.pose, lambda);
-    r.score = score(source, grid, cells, r.pose, k);
+    const auto [xi, score_after] = newton_step(source, grid, cells, k, r.pose, lambda);
+    r.score = score_after;
     if (xi.head<3>().norm() < o.translation_tolerance && xi.tail<3>().norm() < o.rotation_tolerance)
       return true;
   }
