@@ -39,6 +39,7 @@
 #include "odometry/scan_preparation.hpp"
 #include "pipeline/map_terra_options.hpp"
 #include "pipeline/motion_frame.hpp"
+#include "terra/ground_vote.hpp"
 #include "terra/lattice.hpp"
 #include "terra/search.hpp"
 #include "ulc/core/point_cloud.hpp"
@@ -159,6 +160,24 @@ auto build_local_map(const Frames& frames, const std::vector<double>& times, std
   return map;
 }
 
+/// The ground vote of the target's anchor frame against the base's map, into the motion report:
+/// a confident vote's rotation is the maps' answer (MotionFrameOptions::ground_vote), ahead of
+/// the ground and travel's.
+template <class BasePoints, class TargetFrame>
+void add_ground_vote(const BasePoints& base_map, const TargetFrame& target_frame,
+                     const MotionFrameOptions& o, MotionReport& m) {
+  m.vote = terra::ground_vote(base_map, target_frame, o.vote);
+  m.vote_ran = true;
+  if (!m.vote.ok) {
+    if (!m.ok) m.reason += "; ground vote: " + m.vote.reason;
+    return;
+  }
+  m.ok = true;
+  m.reason.clear();
+  m.rotation = m.vote.rotation;
+  m.method = "ground vote";
+}
+
 /// Both LiDARs' local maps over their windows and the motion frame they give, before any search.
 template <typename SA, typename SB>
 struct LocalMaps {
@@ -183,14 +202,21 @@ auto build_local_maps(const FramesA& frames_a, const std::vector<double>& times_
   LocalMaps<typename decltype(a.points)::value_type::Scalar,
             typename decltype(b.points)::value_type::Scalar>
       maps{std::move(a), std::move(b), {}, 0.0};
-  if (!maps.ok())
+  if (!maps.ok()) {
     maps.motion.reason = "a local map could not be built";
-  else if (options.motion.enabled)
+  } else if (options.motion.enabled) {
     maps.motion =
         motion_rotation(motion_view(maps.a.points, maps.a.travel, options.motion),
                         motion_view(maps.b.points, maps.b.travel, options.motion), options.motion);
-  else
+    if (maps.motion.ok) maps.motion.method = "ground and travel";
+    if (options.motion.ground_vote) {
+      const std::size_t n = maps.b.stats.frames;
+      const std::size_t anchor = options.anchor == MapAnchor::last_frame ? first + n - 1 : first;
+      add_ground_vote(maps.a.points, frames_b[anchor], options.motion, maps.motion);
+    }
+  } else {
     maps.motion.reason = "the motion frame is disabled (MapTerraOptions::motion)";
+  }
   maps.seconds = map_terra_detail::seconds_since(t0);
   if (progress) progress(1.0);
   return maps;

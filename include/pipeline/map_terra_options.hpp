@@ -8,6 +8,7 @@
 
 #include "odometry/options.hpp"
 #include "odometry/status.hpp"
+#include "terra/ground_vote_options.hpp"
 #include "ulc/core/types.hpp"
 
 namespace ulc {
@@ -42,6 +43,22 @@ struct MotionFrameOptions {
   /// where it works); one farther off is overruled. Wider than the motion frame's own errors
   /// (up to 11 deg measured), so a right answer is never overruled.
   double agree_deg = 15.0;
+  /// The same when the maps' answer is the ground vote's: its right answers lie within
+  /// 0.1-3 deg of the truth (a few 5-8 deg), so a search answer 10-15 deg off no longer stands
+  /// beside it (bench_terra --windows, 32-avia: such answers kept under 15 deg failed 5 of 50
+  /// windows; docs/experiments/terra_ground_vote.md).
+  double vote_agree_deg = 5.0;
+  /// The threshold for a report's method (the ground vote's or the ground and travel's).
+  double agree_for(const std::string& method) const {
+    return method == "ground vote" ? vote_agree_deg : agree_deg;
+  }
+  /// The ground vote (terra/ground_vote.hpp: the target's anchor frame against the base's
+  /// map, both levelled on their ground, yaw and lever arm voted for). When it is confident
+  /// its rotation is the maps' answer, ahead of the ground and travel: it needs no travel and
+  /// no target odometry. Measured (bench_terra --windows, 2 s, seeds 1 and 2;
+  /// docs/experiments/terra_ground_vote.md).
+  bool ground_vote = true;
+  terra::GroundVoteOptions vote;
 };
 
 /// What the motion frame found; `rotation` only when ok.
@@ -56,6 +73,11 @@ struct MotionReport {
   /// it (then it is the first hypothesis).
   double search_off_deg = 0.0;
   bool used = false;
+  /// Where `rotation` came from: "ground vote" (a confident vote), "ground and travel", or
+  /// empty when neither answered.
+  std::string method;
+  terra::GroundVoteResult vote;  ///< the ground vote, when it ran (vote_ran)
+  bool vote_ran = false;
 };
 
 struct MapTerraOptions {

@@ -9,8 +9,9 @@
 //     says which search was kept ("source") and why.
 //   - The motion frame (motion_frame.hpp; not in the paper): whenever the local maps are built
 //     (source maps, or automatic with enough frames in the window: built even when the frames
-//     overlap well, to check them), the maps' ground and travel give a rotation of their own.
-//     A kept answer within MotionFrameOptions::agree_deg of it stands (the paper's search
+//     overlap well, to check them), the maps give a rotation of their own: the ground vote's
+//     when it is confident (terra/ground_vote.hpp), else the ground and travel's.
+//     A kept answer within MotionFrameOptions::agree_for(method) of it stands (the paper's search
 //     where it works); a farther one, or a failed search, is overruled: the motion frame's
 //     rotation becomes the stage's answer and the first hypothesis. In automatic, frames that
 //     overlap well but disagree with the motion frame also bring the map search in.
@@ -193,7 +194,7 @@ inline void motion_vote(TerraSearches& searches, const MotionFrameOptions& o, Te
   MotionReport& m = *searches.motion;
   if (m.ok) {
     m.search_off_deg = off_motion_deg(searches.kept, m);
-    m.used = m.search_off_deg > o.agree_deg;
+    m.used = m.search_off_deg > o.agree_for(m.method);
   }
   if (m.used) {
     if (!searches.kept.ok())
@@ -212,8 +213,8 @@ TerraSearches automatic_with_maps(const TerraInputs<FA, FB>& in, const terra::Se
   const TerraSourceOptions& src = in.options.tuning.terra_source;
   const auto maps = build_maps(in);
   const bool overlap = f.ok() && f.mask_count >= src.maps_below_mask;
-  const bool contradicted =
-      maps.motion.ok && off_motion_deg(f, maps.motion) > src.maps.motion.agree_deg;
+  const bool contradicted = maps.motion.ok && off_motion_deg(f, maps.motion) >
+                                                  src.maps.motion.agree_for(maps.motion.method);
   if (overlap && !contradicted) {
     report = frames_report(in, f,
                            "automatic: the frames overlap in " + std::to_string(f.mask_count) +

@@ -116,7 +116,7 @@ TEST_CASE("a JEEP that did not settle is judged by HOTS, which confirms and refi
   CHECK(same_bits(vetoed.T_base_target, *o.initial));
 }
 
-TEST_CASE("the fallback finds the 90-deg-pitched VLP-16 where the map search's optima all fail",
+TEST_CASE("the ground vote, or without it the fallback, finds the 90-deg-pitched VLP-16",
           "[calibrate][hypotheses][fallback]") {
   // pitched-90, seed 2, 10 s (docs/experiments/terra_fallback_hypotheses.md): the frames
   // overlap in a few cells, so the automatic rule keeps the maps, whose optima are all far from
@@ -130,12 +130,28 @@ TEST_CASE("the fallback finds the 90-deg-pitched VLP-16 where the map search's o
   const ulc::Isometry3d truth = d.pairs[0].T_base_target;
   ulc::CalibrateOptions o;
   o.time_offset_s = 0.0;
+  {
+    // The ground vote needs no odometry of the target: its answer is the first hypothesis.
+    const auto c = ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, o);
+    INFO(ulc::to_string(c.status) << ": " << c.reason);
+    REQUIRE(c.terra);
+    REQUIRE(c.terra->motion);
+    CHECK(c.terra->motion->method == "ground vote");
+    CHECK(c.terra->hypothesis_used == 0);
+    REQUIRE((c.success || c.status == CalibrateStatus::uncertain));
+    const auto e = ulc::pose_error(truth, c.T_base_target);
+    INFO("e_rot " << e.rotation_deg << " deg, e_trans " << e.translation_m << " m");
+    CHECK(e.rotation_deg < 0.1);
+    CHECK(e.translation_m < 0.02);
+  }
+  // Without the ground vote, the fallback's path.
+  o.tuning.terra_source.maps.motion.ground_vote = false;
   const auto c = ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, o);
   INFO(ulc::to_string(c.status) << ": " << c.reason);
   REQUIRE(c.terra);
   CHECK(c.terra->source == ulc::TerraSource::maps);
-  // The motion frame cannot help: the vertically spinning VLP-16's own odometry travels 10 m
-  // where the base travels 28 (measured), and the travel check refuses it.
+  // The ground and travel cannot help: the vertically spinning VLP-16's own odometry travels
+  // 10 m where the base travels 28 (measured), and the travel check refuses it.
   REQUIRE(c.terra->motion);
   CHECK_FALSE(c.terra->motion->ok);
   CHECK_THAT(c.terra->motion->reason, Catch::Contains("disagree on the distance"));

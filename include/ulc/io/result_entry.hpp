@@ -47,6 +47,20 @@ inline Json local_map_stats(const LocalMapStats& m) {
   return j;
 }
 
+inline Json ground_vote_report(const terra::GroundVoteResult& v) {
+  Json j = Json::object();
+  j["ok"] = v.ok;
+  j["reason"] = v.reason;
+  j["rpy_deg"] = vector_to_json(rpy_from_rotation(v.rotation) * kDegPerRad);
+  j["translation_m"] = vector_to_json(v.translation);
+  j["score"] = v.score;
+  // Infinite when no rival peak: JSON has no infinity.
+  j["margin"] = std::isfinite(v.margin) ? Json(v.margin) : Json();
+  j["points"] = v.points;
+  j["target_plane"] = v.target_plane;
+  return j;
+}
+
 inline Json motion_report(const MotionReport& m) {
   Json j = Json::object();
   j["ok"] = m.ok;
@@ -59,6 +73,8 @@ inline Json motion_report(const MotionReport& m) {
   j["planes_matched"] = m.planes_matched;
   if (m.ok) j["search_off_deg"] = m.search_off_deg;
   j["used"] = m.used;
+  j["method"] = m.method;
+  if (m.vote_ran) j["ground_vote"] = ground_vote_report(m.vote);
   return j;
 }
 

@@ -1,0 +1,294 @@
+// The ground vote: R_base_target, with no prior, from one target frame and a base cloud (a
+// local map) when both see the road. Not in the paper (issue 34: TERRA on narrow fields of
+// view). With each cloud levelled on its ground, what is left is one angle (the yaw about the
+// ground's normal) and the lever arm along the ground; every target point above the ground
+// that lands on a surface the base saw is one vote, so a narrow field of view that fills a
+// dozen of TERRA's lattice cells still brings hundreds of votes. Measured in
+// docs/experiments/terra_ground_vote.md.
+//
+// Conventions this header owns:
+//   - Levelling: a plane n.p + d = 0 (normal towards the sensor, plane_fit.hpp) taken as the
+//     ground maps p to (L p).x, (L p).y and the height n.p + d, L = levelling_rotation(n).
+//   - The base's ground is its largest plane; the target's is each of its `target_planes`
+//     largest planes in turn (a narrow LiDAR's largest plane may be a wall) whose distance to
+//     the target is within max_height_difference of the base's height above its ground.
+//   - Votes: the target's points with heights in [min_height, max_height) within max_range
+//     (horizontal), one per voxel, at most max_points (every k-th of the voxels in key order).
+//     The score of (yaw, tx, ty) is the share of them that land in a voxel the base occupies
+//     after Rz(yaw) and the shift (tx, ty, 0); |tx|, |ty| <= max_translation.
+//   - Search: yaw over the circle in coarse_step_deg on a grid of twice the voxel, translation
+//     in steps of that voxel; the peaks_per_plane best local maxima (peak_separation_deg
+//     apart) refined in fine_step_deg within one coarse step on the fine grid, translation in
+//     voxel steps over the whole range.
+//   - Margin: the best refined score over the best of the refined peaks whose rotation lies
+//     more than margin_separation_deg from the winner's (infinite when there is none).
+//   - Grounds with fewer than min_points voxels above them do not vote (none left: refused).
+//   - ok (a confident answer) when at least min_score of the votes landed and the margin is at
+//     least min_margin; otherwise the best answer is still filled in, with the reason.
+//   - Result: R = L_b^T Rz(yaw) L_t and t = L_b^T (tx, ty, d_t - d_b).
+//   - Deterministic: per-yaw and per-peak slots filled in parallel, reduced in order; nothing
+//     here throws or prints.
+#pragma once
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "terra/ground_vote_options.hpp"
+#include "terra/occupancy_grid.hpp"
+#include "terra/plane_fit.hpp"
+#include "terra/scan_context.hpp"
+#include "ulc/core/point_traits.hpp"
+#include "ulc/core/types.hpp"
+
+namespace terra {
+
+namespace ground_vote_detail {
+
+constexpr double kRadPerDeg = 3.14159265358979323846 / 180.0;
+
+/// A cloud's points levelled on `plane` (see the conventions), above the ground and in range.
+template <class Cloud>
+std::vector<ulc::Vec3d> levelled(const Cloud& cloud, const PlaneFit& plane,
+                                 const GroundVoteOptions& o) {
+  const ulc::Mat3d L = levelling_rotation(plane.normal);
+  std::vector<ulc::Vec3d> out;
+  for (std::size_t i = 0; i < ulc::traits::size(cloud); ++i) {
+    const ulc::Vec3d p = ulc::traits::point(cloud, i).template cast<double>();
+    if (!p.allFinite() || p.norm() < o.plane.min_range) continue;
+    ulc::Vec3d q = L * p;
+    q.z() = plane.normal.dot(p) + plane.offset;
+    if (q.z() >= o.min_height && q.z() < o.max_height && q.head<2>().norm() <= o.max_range)
+      out.push_back(q);
+  }
+  return out;
+}
+
+/// One point per voxel (the first in key order), then every k-th so at most max_points stay.
+inline std::vector<ulc::Vec3d> one_per_voxel(const std::vector<ulc::Vec3d>& pts, double voxel,
+                                             std::size_t max_points) {
+  std::vector<std::pair<std::int64_t, std::size_t>> keys;
+  keys.reserve(pts.size());
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    // Heights < max_height and |x|, |y| <= max_range: 21 bits per axis hold the keys.
+    const auto x = static_cast<std::int64_t>(std::floor(pts[i].x() / voxel)) + (1 << 20);
+    const auto y = static_cast<std::int64_t>(std::floor(pts[i].y() / voxel)) + (1 << 20);
+    const auto z = static_cast<std::int64_t>(std::floor(pts[i].z() / voxel)) + (1 << 20);
+    keys.emplace_back((x << 42) | (y << 21) | z, i);
+  }
+  std::sort(keys.begin(), keys.end());
+  std::vector<ulc::Vec3d> out;
+  for (std::size_t k = 0; k < keys.size(); ++k)
+    if (k == 0 || keys[k].first != keys[k - 1].first) out.push_back(pts[keys[k].second]);
+  if (max_points > 0 && out.size() > max_points) {
+    const std::size_t step = (out.size() + max_points - 1) / max_points;
+    std::size_t n = 0;
+    for (std::size_t k = 0; k < out.size(); k += step) out[n++] = out[k];
+    out.resize(n);
+  }
+  return out;
+}
+
+inline OccupancyGrid base_grid(const std::vector<ulc::Vec3d>& base, double voxel,
+                               const GroundVoteOptions& o) {
+  OccupancyGrid g(voxel, o.max_range + o.max_translation + voxel, o.min_height, o.max_height);
+  for (const ulc::Vec3d& p : base) g.mark(p);
+  return g;
+}
+
+/// A yaw, the shift along the ground, and the votes they gather.
+struct Peak {
+  double yaw_deg = 0.0;
+  double tx = 0.0, ty = 0.0;
+  std::size_t votes = 0;
+  std::size_t plane = 0;
+};
+
+/// The best shift of the target turned by `yaw_deg`, over steps of the grid's voxel within
+/// max_translation (ties: the first in x then y).
+inline Peak best_shift(const OccupancyGrid& grid, const std::vector<ulc::Vec3d>& target,
+                       double yaw_deg, const GroundVoteOptions& o) {
+  const double step = grid.voxel();
+  const int n = static_cast<int>(std::floor(o.max_translation / step));
+  const int side = 2 * n + 1;
+  std::vector<std::size_t> votes(static_cast<std::size_t>(side * side), 0);
+  const double c = std::cos(yaw_deg * kRadPerDeg), s = std::sin(yaw_deg * kRadPerDeg);
+  for (const ulc::Vec3d& p : target) {
+    const ulc::Vec3d q(c * p.x() - s * p.y(), s * p.x() + c * p.y(), p.z());
+    for (int a = -n; a <= n; ++a)
+      for (int b = -n; b <= n; ++b)
+        votes[static_cast<std::size_t>((a + n) * side + b + n)] +=
+            grid.occupied(q + ulc::Vec3d(a * step, b * step, 0.0));
+  }
+  Peak best;
+  best.yaw_deg = yaw_deg;
+  for (int a = -n; a <= n; ++a)
+    for (int b = -n; b <= n; ++b) {
+      const std::size_t v = votes[static_cast<std::size_t>((a + n) * side + b + n)];
+      if (v > best.votes) best.votes = v, best.tx = a * step, best.ty = b * step;
+    }
+  return best;
+}
+
+/// Each yaw's best shift, for yaws first, first + step, ... (count of them), in parallel.
+inline std::vector<Peak> sweep(const OccupancyGrid& grid, const std::vector<ulc::Vec3d>& target,
+                               double first_deg, double step_deg, std::size_t count,
+                               const GroundVoteOptions& o) {
+  std::vector<Peak> out(count);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t k = r.begin(); k < r.end(); ++k)
+                        out[k] = best_shift(grid, target, first_deg + step_deg * double(k), o);
+                    });
+  return out;
+}
+
+inline double yaw_gap_deg(double a, double b) {
+  return std::fabs(std::remainder(a - b, 360.0));
+}
+
+/// The `count` best local maxima of a circular sweep, at least `separation` deg apart.
+inline std::vector<Peak> best_peaks(const std::vector<Peak>& sweep, std::size_t count,
+                                    double separation) {
+  std::vector<Peak> maxima;
+  const std::size_t n = sweep.size();
+  for (std::size_t k = 0; k < n; ++k) {
+    const Peak& p = sweep[k];
+    if (p.votes > 0 && p.votes >= sweep[(k + n - 1) % n].votes &&
+        p.votes >= sweep[(k + 1) % n].votes)
+      maxima.push_back(p);
+  }
+  std::stable_sort(maxima.begin(), maxima.end(),
+                   [](const Peak& a, const Peak& b) { return a.votes > b.votes; });
+  std::vector<Peak> out;
+  for (const Peak& p : maxima) {
+    if (out.size() == count) break;
+    if (std::none_of(out.begin(), out.end(),
+                     [&](const Peak& q) { return yaw_gap_deg(p.yaw_deg, q.yaw_deg) < separation; }))
+      out.push_back(p);
+  }
+  return out;
+}
+
+/// One target ground candidate, levelled and thinned.
+struct TargetGround {
+  PlaneFit plane;
+  std::vector<ulc::Vec3d> points;
+};
+
+/// The refined peak nearest `coarse` (within one coarse step either side).
+inline Peak refine(const OccupancyGrid& fine, const TargetGround& t, const Peak& coarse,
+                   const GroundVoteOptions& o) {
+  const auto half = static_cast<std::size_t>(std::floor(o.coarse_step_deg / o.fine_step_deg));
+  const std::vector<Peak> local =
+      sweep(fine, t.points, coarse.yaw_deg - o.fine_step_deg * double(half), o.fine_step_deg,
+            2 * half + 1, o);
+  Peak best = local.front();
+  for (const Peak& p : local)
+    if (p.votes > best.votes) best = p;
+  best.plane = coarse.plane;
+  return best;
+}
+
+inline ulc::Mat3d rotation_of(const PlaneFit& base, const PlaneFit& target, double yaw_deg) {
+  return levelling_rotation(base.normal).transpose() *
+         Eigen::AngleAxisd(yaw_deg * kRadPerDeg, ulc::Vec3d::UnitZ()).toRotationMatrix() *
+         levelling_rotation(target.normal);
+}
+
+inline double angle_deg(const ulc::Mat3d& a, const ulc::Mat3d& b) {
+  const Eigen::AngleAxisd d(a.transpose() * b);
+  return std::fabs(d.angle()) / kRadPerDeg;
+}
+
+/// An options problem, else empty.
+inline std::string options_problem(const GroundVoteOptions& o) {
+  if (!(o.voxel > 0.0 && o.max_translation >= 0.0 && o.max_range > 0.0 &&
+        o.max_height > o.min_height && o.coarse_step_deg > 0.0 && o.fine_step_deg > 0.0 &&
+        o.fine_step_deg <= o.coarse_step_deg && o.coarse_voxel >= o.voxel &&
+        o.max_range / o.voxel < 1e5))
+    return "invalid options (voxel, steps, ranges or heights)";
+  return {};
+}
+
+}  // namespace ground_vote_detail
+
+/// R_base_target from the base cloud and one target frame (see the conventions above).
+template <class BaseCloud, class TargetCloud>
+GroundVoteResult ground_vote(const BaseCloud& base, const TargetCloud& target,
+                             const GroundVoteOptions& o = {}) {
+  using namespace ground_vote_detail;
+  GroundVoteResult r;
+  if (std::string why = options_problem(o); !why.empty()) return r.reason = why, r;
+  const std::vector<PlaneFit> base_planes = largest_planes(base, 1, o.min_plane_points, o.plane);
+  if (base_planes.empty()) return r.reason = "the base shows no ground plane", r;
+  std::vector<TargetGround> grounds;
+  for (const PlaneFit& p : largest_planes(target, o.target_planes, o.min_plane_points, o.plane))
+    if (std::fabs(p.offset - base_planes.front().offset) <= o.max_height_difference)
+      grounds.push_back({p, one_per_voxel(levelled(target, p, o), o.voxel, o.max_points)});
+  if (grounds.empty())
+    return r.reason = "none of the target's largest planes lies at the base's ground's height", r;
+  const std::vector<ulc::Vec3d> base_points = levelled(base, base_planes.front(), o);
+  const OccupancyGrid coarse = base_grid(base_points, o.coarse_voxel, o);
+  const OccupancyGrid fine = base_grid(base_points, o.voxel, o);
+  // Coarse sweeps, their best peaks refined; the votes compared as shares of each ground's points.
+  std::vector<std::pair<Peak, double>> refined;  // peak, share
+  const auto steps = static_cast<std::size_t>(std::ceil(360.0 / o.coarse_step_deg));
+  // Grounds with too few points above them do not vote (a wall taken for the ground with a
+  // handful of points beside it would win on its share).
+  std::size_t most = 0;
+  for (const TargetGround& g : grounds) most = std::max(most, g.points.size());
+  if (most < o.min_points)
+    return r.reason = "only " + std::to_string(most) + " target voxels above the ground (" +
+                      std::to_string(o.min_points) + " needed)",
+           r;
+  for (std::size_t j = 0; j < grounds.size(); ++j) {
+    if (grounds[j].points.size() < o.min_points) continue;
+    for (Peak p : best_peaks(sweep(coarse, grounds[j].points, 0.0, o.coarse_step_deg, steps, o),
+                             o.peaks_per_plane, o.peak_separation_deg)) {
+      p.plane = j;
+      const Peak f = refine(fine, grounds[j], p, o);
+      refined.emplace_back(f, double(f.votes) / double(grounds[j].points.size()));
+    }
+  }
+  if (refined.empty()) return r.reason = "no target point above the ground lands on the base", r;
+  std::size_t win = 0;
+  for (std::size_t k = 1; k < refined.size(); ++k)
+    if (refined[k].second > refined[win].second) win = k;
+  const Peak& w = refined[win].first;
+  const TargetGround& g = grounds[w.plane];
+  r.rotation = rotation_of(base_planes.front(), g.plane, w.yaw_deg);
+  const double dz = g.plane.offset - base_planes.front().offset;
+  r.translation =
+      levelling_rotation(base_planes.front().normal).transpose() * ulc::Vec3d(w.tx, w.ty, dz);
+  r.score = refined[win].second;
+  r.points = g.points.size();
+  r.target_plane = w.plane;
+  r.base_height = base_planes.front().offset;
+  r.target_height = g.plane.offset;
+  double rival = 0.0;
+  for (const auto& [p, share] : refined)
+    if (angle_deg(rotation_of(base_planes.front(), grounds[p.plane].plane, p.yaw_deg), r.rotation) >
+        o.margin_separation_deg)
+      rival = std::max(rival, share);
+  r.margin = rival > 0.0 ? r.score / rival : std::numeric_limits<double>::infinity();
+  if (!(r.score >= o.min_score))
+    r.reason = "only " + std::to_string(int(100.0 * r.score)) +
+               " % of the target's votes land on the base's surfaces";
+  else if (!(r.margin >= o.min_margin))
+    r.reason = "ambiguous: a rotation more than " + std::to_string(int(o.margin_separation_deg)) +
+               " deg away gathers 1/" + std::to_string(r.margin).substr(0, 4) +
+               " of the best one's votes";
+  r.ok = r.reason.empty();
+  return r;
+}
+
+}  // namespace terra
