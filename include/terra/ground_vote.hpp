@@ -216,6 +216,11 @@ inline std::string options_problem(const GroundVoteOptions& o) {
         o.fine_step_deg <= o.coarse_step_deg && o.coarse_voxel >= o.voxel &&
         o.max_range / o.voxel < 1e5))
     return "invalid options (voxel, steps, ranges or heights)";
+  // The fine grid's cells (one byte each): bounded, whatever the options ask.
+  const double side = 2.0 * (o.max_range + o.max_translation + o.voxel) / o.voxel;
+  if (side * side * (o.max_height - o.min_height) / o.voxel > 2e8)
+    return "invalid options: the occupancy grid would exceed 200 MB (voxel too fine for the "
+           "range and heights)";
   return {};
 }
 

@@ -104,6 +104,10 @@ TEST_CASE("the ground vote refuses bad input with a reason, never a crash",
   const terra::GroundVoteResult v = terra::ground_vote(base, base, bad);
   CHECK_FALSE(v.ok);
   CHECK(v.reason.find("invalid options") != std::string::npos);
+  terra::GroundVoteOptions huge;  // 1 cm voxels over 500 m: no 10^13-byte grid
+  huge.voxel = huge.coarse_voxel = 0.01;
+  huge.max_range = 500.0;
+  CHECK_THAT(terra::ground_vote(base, base, huge).reason, Catch::Contains("200 MB"));
 }
 
 TEST_CASE("the ground vote gives the same bits on 1 and 2 threads", "[terra][ground_vote]") {
