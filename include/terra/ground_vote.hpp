@@ -36,7 +36,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
-#include <cstdint>
 #include <limits>
 #include <string>
 #include <utility>
@@ -47,7 +46,9 @@
 #include "terra/plane_fit.hpp"
 #include "terra/scan_context.hpp"
 #include "ulc/core/point_traits.hpp"
+#include "ulc/core/pose_error.hpp"
 #include "ulc/core/types.hpp"
+#include "ulc/core/voxel.hpp"
 
 namespace terra {
 
@@ -75,15 +76,11 @@ std::vector<ulc::Vec3d> levelled(const Cloud& cloud, const PlaneFit& plane,
 /// One point per voxel (the first in key order), then every k-th so at most max_points stay.
 inline std::vector<ulc::Vec3d> one_per_voxel(const std::vector<ulc::Vec3d>& pts, double voxel,
                                              std::size_t max_points) {
-  std::vector<std::pair<std::int64_t, std::size_t>> keys;
+  std::vector<std::pair<ulc::VoxelKey, std::size_t>> keys;
   keys.reserve(pts.size());
-  for (std::size_t i = 0; i < pts.size(); ++i) {
-    // Heights < max_height and |x|, |y| <= max_range: 21 bits per axis hold the keys.
-    const auto x = static_cast<std::int64_t>(std::floor(pts[i].x() / voxel)) + (1 << 20);
-    const auto y = static_cast<std::int64_t>(std::floor(pts[i].y() / voxel)) + (1 << 20);
-    const auto z = static_cast<std::int64_t>(std::floor(pts[i].z() / voxel)) + (1 << 20);
-    keys.emplace_back((x << 42) | (y << 21) | z, i);
-  }
+  for (std::size_t i = 0; i < pts.size(); ++i)
+    // Always a key: levelled points lie within max_range and max_height (options_problem).
+    if (const auto k = ulc::make_voxel_key(pts[i], voxel)) keys.emplace_back(*k, i);
   std::sort(keys.begin(), keys.end());
   std::vector<ulc::Vec3d> out;
   for (std::size_t k = 0; k < keys.size(); ++k)
@@ -204,11 +201,6 @@ inline ulc::Mat3d rotation_of(const PlaneFit& base, const PlaneFit& target, doub
          levelling_rotation(target.normal);
 }
 
-inline double angle_deg(const ulc::Mat3d& a, const ulc::Mat3d& b) {
-  const Eigen::AngleAxisd d(a.transpose() * b);
-  return std::fabs(d.angle()) / kRadPerDeg;
-}
-
 /// An options problem, else empty.
 inline std::string options_problem(const GroundVoteOptions& o) {
   if (!(o.voxel > 0.0 && o.max_translation >= 0.0 && o.max_range > 0.0 &&
@@ -281,7 +273,9 @@ GroundVoteResult ground_vote(const BaseCloud& base, const TargetCloud& target,
   r.target_height = g.plane.offset;
   double rival = 0.0;
   for (const auto& [p, share] : refined)
-    if (angle_deg(rotation_of(base_planes.front(), grounds[p.plane].plane, p.yaw_deg), r.rotation) >
+    if (ulc::rotation_error_rad(rotation_of(base_planes.front(), grounds[p.plane].plane, p.yaw_deg),
+                                r.rotation) /
+            kRadPerDeg >
         o.margin_separation_deg)
       rival = std::max(rival, share);
   r.margin = rival > 0.0 ? r.score / rival : std::numeric_limits<double>::infinity();
