@@ -22,6 +22,9 @@
 //   - The motion frame (motion_frame.hpp, MapTerraOptions::motion): each map's travel over the
 //     window (first to last frame, in the anchor frame) and largest planes give a rotation of
 //     their own, reported beside the search's; the TERRA stage (terra_stage.hpp) decides.
+//     The ground vote (window_vote.hpp) goes ahead of them when it is sure: a few target
+//     frames of the window, each against the base's map moved into the base frame nearest it
+//     in time (LocalMap::poses).
 //   - Deterministic for any thread count (odometry, voxel thinning and search all are).
 //   - Nothing here throws, exits or prints; it compiles with -fno-exceptions.
 #pragma once
@@ -39,6 +42,7 @@
 #include "odometry/scan_preparation.hpp"
 #include "pipeline/map_terra_options.hpp"
 #include "pipeline/motion_frame.hpp"
+#include "pipeline/window_vote.hpp"
 #include "terra/ground_vote.hpp"
 #include "terra/lattice.hpp"
 #include "terra/search.hpp"
@@ -51,8 +55,9 @@ namespace ulc {
 
 template <typename S>
 struct LocalMap {
-  std::vector<Vec3<S>> points;   ///< in the LiDAR's frame at the anchor frame
-  Vec3d travel = Vec3d::Zero();  ///< the window's first to last position, in the anchor frame
+  std::vector<Vec3<S>> points;    ///< in the LiDAR's frame at the anchor frame
+  Vec3d travel = Vec3d::Zero();   ///< the window's first to last position, in the anchor frame
+  std::vector<Isometry3d> poses;  ///< each window frame's pose in the anchor frame
   LocalMapStats stats;
   bool ok = false;  ///< the odometry gave poses (else points is empty and stats say why)
 };
@@ -140,10 +145,11 @@ auto build_local_map(const Frames& frames, const std::vector<double>& times, std
   const Isometry3d& last_pose = odo.steps.back().pose_a;
   const Isometry3d& anchor = options.anchor == MapAnchor::last_frame ? last_pose : first_pose;
   map.travel = anchor.linear().transpose() * (last_pose.translation() - first_pose.translation());
-  if (options.anchor == MapAnchor::last_frame) {
-    const Isometry3d to_last = last_pose.inverse();
-    for (auto& p : stack.points) p = (to_last * p.template cast<double>()).template cast<S>();
-  }
+  const Isometry3d from_anchor = anchor.inverse();
+  if (options.anchor == MapAnchor::last_frame)
+    for (auto& p : stack.points) p = (from_anchor * p.template cast<double>()).template cast<S>();
+  for (const odometry::OdometryStep& step : odo.steps)
+    map.poses.push_back(from_anchor * step.pose_a);
   map.stats.stacked_points = stack.points.size();
   // Thin: the voxel doubles until the map fits (a handful of passes at most).
   double voxel = options.voxel > 0.0 ? options.voxel : 0.2;
@@ -160,16 +166,54 @@ auto build_local_map(const Frames& frames, const std::vector<double>& times, std
   return map;
 }
 
-/// The ground vote of the target's anchor frame against the base's map, into the motion report:
-/// a confident vote's rotation is the maps' answer (MotionFrameOptions::ground_vote), ahead of
-/// the ground and travel's.
-template <class BasePoints, class TargetFrame>
-void add_ground_vote(const BasePoints& base_map, const TargetFrame& target_frame,
-                     const MotionFrameOptions& o, MotionReport& m) {
-  m.vote = terra::ground_vote(base_map, target_frame, o.vote);
+namespace map_terra_detail {
+
+/// The base map's points in the frame of its window frame `k` (poses are in the anchor frame).
+template <typename S>
+std::vector<Vec3<S>> map_at_frame(const LocalMap<S>& map, std::size_t k) {
+  const Isometry3d to_frame = map.poses[k].inverse();
+  std::vector<Vec3<S>> out;
+  out.reserve(map.points.size());
+  for (const auto& p : map.points)
+    out.push_back((to_frame * p.template cast<double>()).template cast<S>());
+  return out;
+}
+
+/// The window frame of `times` (from `first`, `count` of them) nearest `t`.
+inline std::size_t nearest_frame(const std::vector<double>& times, std::size_t first,
+                                 std::size_t count, double t) {
+  std::size_t best = 0;
+  for (std::size_t k = 1; k < count; ++k)
+    if (std::fabs(times[first + k] - t) < std::fabs(times[first + best] - t)) best = k;
+  return best;
+}
+
+}  // namespace map_terra_detail
+
+/// The ground vote of a few target window frames against the base's map (window_vote.hpp),
+/// into the motion report: a confident window answer is the maps' rotation, ahead of the
+/// ground and travel's.
+template <typename SA, class FramesB>
+void add_ground_vote(const LocalMap<SA>& base_map, const std::vector<double>& times_a,
+                     const FramesB& frames_b, const std::vector<double>& times_b, std::size_t first,
+                     std::size_t target_frames, std::size_t anchor, const MotionFrameOptions& o,
+                     MotionReport& m) {
+  using namespace map_terra_detail;
+  const std::vector<std::size_t> voted = vote_frame_indices(target_frames, o.vote_frames, anchor);
+  std::vector<terra::GroundVoteResult> votes;
+  for (const std::size_t k : voted) {
+    const std::size_t j = nearest_frame(times_a, first, base_map.poses.size(), times_b[first + k]);
+    votes.push_back(terra::ground_vote(map_at_frame(base_map, j), frames_b[first + k], o.vote));
+  }
+  const VoteTally tally = tally_votes(votes, o.vote_agree_deg);
+  m.vote = votes[tally.chosen];
   m.vote_ran = true;
-  if (!m.vote.ok) {
-    if (!m.ok) m.reason += "; ground vote: " + m.vote.reason;
+  m.vote_frame = voted[tally.chosen];
+  m.votes = votes.size();
+  m.votes_confident = tally.confident;
+  m.votes_agreeing = tally.agreeing;
+  if (!tally.ok) {
+    if (!m.ok) m.reason += "; ground vote: " + tally.reason;
     return;
   }
   m.ok = true;
@@ -211,8 +255,9 @@ auto build_local_maps(const FramesA& frames_a, const std::vector<double>& times_
     if (maps.motion.ok) maps.motion.method = "ground and travel";
     if (options.motion.ground_vote) {
       const std::size_t n = maps.b.stats.frames;
-      const std::size_t anchor = options.anchor == MapAnchor::last_frame ? first + n - 1 : first;
-      add_ground_vote(maps.a.points, frames_b[anchor], options.motion, maps.motion);
+      const std::size_t anchor = options.anchor == MapAnchor::last_frame ? n - 1 : 0;
+      add_ground_vote(maps.a, times_a, frames_b, times_b, first, n, anchor, options.motion,
+                      maps.motion);
     }
   } else {
     maps.motion.reason = "the motion frame is disabled (MapTerraOptions::motion)";

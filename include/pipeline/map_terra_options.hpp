@@ -59,6 +59,10 @@ struct MotionFrameOptions {
   /// docs/experiments/terra_ground_vote.md).
   bool ground_vote = true;
   terra::GroundVoteOptions vote;
+  /// Target frames voted, evenly spaced over the window, each against the base's map at the
+  /// base frame nearest it in time; the answer most confident votes back (window_vote.hpp,
+  /// which cites the measurement). 1: the anchor frame alone.
+  std::size_t vote_frames = 3;
 };
 
 /// What the motion frame found; `rotation` only when ok.
@@ -76,8 +80,12 @@ struct MotionReport {
   /// Where `rotation` came from: "ground vote" (a confident vote), "ground and travel", or
   /// empty when neither answered.
   std::string method;
-  terra::GroundVoteResult vote;  ///< the ground vote, when it ran (vote_ran)
+  terra::GroundVoteResult vote;  ///< the window's vote (window_vote.hpp), when it ran (vote_ran)
   bool vote_ran = false;
+  std::size_t vote_frame = 0;       ///< the window frame whose vote `vote` is
+  std::size_t votes = 0;            ///< frames voted
+  std::size_t votes_confident = 0;  ///< of them confident
+  std::size_t votes_agreeing = 0;   ///< confident and within vote_agree_deg of the answer
 };
 
 struct MapTerraOptions {

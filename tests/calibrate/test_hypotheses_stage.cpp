@@ -138,6 +138,15 @@ TEST_CASE("the ground vote, or without it the fallback, finds the 90-deg-pitched
     REQUIRE(c.terra->motion);
     CHECK(c.terra->motion->method == "ground vote");
     CHECK(c.terra->hypothesis_used == 0);
+    // The result file says which frames voted and how many agreed.
+    const auto json = ulc::io::results_to_json({ulc::io::to_pair_result(c, "base32", "pitched16")});
+    const auto& vote =
+        json.at("results")[0].at("stages").at("terra").at("motion").at("ground_vote");
+    CHECK(vote.at("frames_voted").get<double>() == double(c.terra->motion->votes));
+    CHECK(c.terra->motion->votes == 3);
+    CHECK(vote.at("frames_agreeing").get<double>() >= 1.0);
+    CHECK(vote.at("frames_confident").get<double>() >= vote.at("frames_agreeing").get<double>());
+    CHECK(vote.at("ok").get<bool>());
     REQUIRE((c.success || c.status == CalibrateStatus::uncertain));
     const auto e = ulc::pose_error(truth, c.T_base_target);
     INFO("e_rot " << e.rotation_deg << " deg, e_trans " << e.translation_m << " m");

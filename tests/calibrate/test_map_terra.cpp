@@ -262,7 +262,7 @@ TEST_CASE("a local map is the frames stacked in the anchor frame, thinned to its
   CHECK(none.points.empty());
 }
 
-TEST_CASE("the ground vote gives the 64-tele rotation from one Tele frame, no target odometry",
+TEST_CASE("the ground vote gives the 64-tele rotation from Tele frames, no target odometry",
           "[calibrate][map_terra][ground_vote]") {
   const auto& d = drive_64_tele();
   const auto& a = d.lidars[0];
@@ -278,14 +278,20 @@ TEST_CASE("the ground vote gives the 64-tele rotation from one Tele frame, no ta
     const std::size_t first = start_index(d) + 3 * k;
     const auto maps = ulc::build_local_maps(a.frames, a.timestamps, turned, b.timestamps, first, o);
     REQUIRE(maps.ok());
+    // The base map's poses: one per window frame, the anchor (last) frame's the identity.
+    REQUIRE(maps.a.poses.size() == maps.a.stats.frames);
+    CHECK(maps.a.poses.back().isApprox(Eigen::Isometry3d::Identity(), 1e-12));
     const ulc::MotionReport& m = maps.motion;
     REQUIRE(m.vote_ran);
-    INFO("window " << k << ": " << m.vote.reason << ", margin " << m.vote.margin << ", score "
-                   << m.vote.score);
-    CHECK(m.ok == m.vote.ok);
-    if (!m.vote.ok) continue;
+    INFO("window " << k << ": " << m.reason << "; chosen vote " << m.vote.reason << ", margin "
+                   << m.vote.margin << ", score " << m.vote.score);
+    CHECK(m.votes == 3);
+    CHECK(m.votes_agreeing <= m.votes_confident);
+    CHECK(m.ok == (m.method == "ground vote"));
+    if (!m.ok) continue;
     ++confident;
-    CHECK(m.method == "ground vote");
+    CHECK(m.vote.ok);
+    CHECK(m.votes_agreeing >= 1);
     CHECK(m.rotation == m.vote.rotation);
     CHECK(error_deg(truth, m.vote.rotation) < 3.0);
     // The target's height against the base's: the mounts differ by 0.2 m (scenario.hpp).

@@ -74,7 +74,13 @@ inline Json motion_report(const MotionReport& m) {
   if (m.ok) j["search_off_deg"] = m.search_off_deg;
   j["used"] = m.used;
   j["method"] = m.method;
-  if (m.vote_ran) j["ground_vote"] = ground_vote_report(m.vote);
+  if (m.vote_ran) {
+    j["ground_vote"] = ground_vote_report(m.vote);
+    j["ground_vote"]["window_frame"] = m.vote_frame;
+    j["ground_vote"]["frames_voted"] = m.votes;
+    j["ground_vote"]["frames_confident"] = m.votes_confident;
+    j["ground_vote"]["frames_agreeing"] = m.votes_agreeing;
+  }
   return j;
 }
 
