@@ -44,7 +44,9 @@
 //     When all of those fail, up to tuning.hypotheses.fallback more (the kept search's other
 //     optima, then those of the search not kept) run, each needing JEEP's own acceptance before
 //     HOTS. With none, the best one's failure is reported. stages.terra.hypotheses lists each one
-//     tried and its outcome; timings sum over all of them.
+//     tried and its outcome; timings sum over all of them. Each starts from its rotation and
+//     translation 0, or from the ground vote's lever arm when it lies within vote_agree_deg of
+//     a confident vote's rotation (StartRotations::start).
 //   - Degenerate verdict (observability_verdict.hpp): when the call ends, the final problem's
 //     information for the extrinsic (HOTS's whole-sequence step, else JEEP's final
 //     registration) is judged; a direction it leaves free makes the status degenerate, over
@@ -192,7 +194,8 @@ std::optional<StartRotations> terra_step(const FA& frames_a, const std::vector<d
   r.timing_s.terra = report.seconds;
   r.terra = std::move(report);
   if (!searches.ok()) return std::nullopt;
-  return start_rotations(searches, r.terra->source, options.tuning.hypotheses);
+  return start_rotations(searches, r.terra->source, options.tuning.hypotheses,
+                         options.tuning.terra_source.maps.motion);
 }
 
 /// TERRA's hypotheses in turn (terra_hypotheses.hpp): when what followed one points at its
@@ -205,8 +208,7 @@ PairCalibration try_hypotheses(const AttemptInputs<FA, FB>& in, const StartRotat
   StageOutcome first_outcome;
   for (std::size_t k = 0; k < starts.candidates.size(); ++k) {
     const auto t0 = std::chrono::steady_clock::now();
-    Isometry3d start = Isometry3d::Identity();
-    start.linear() = starts.candidates[k].rotation;
+    const Isometry3d start = starts.start(k);
     PairCalibration attempt;
     attempt.time_offset_s = r.time_offset_s;
     const std::string label = k == 0 ? "" : " (hypothesis " + std::to_string(k + 1) + ")";

@@ -272,13 +272,40 @@ struct StartRotations {
   std::vector<TerraSource> sources;  ///< the search each candidate is an optimum of
   std::size_t first_fallback = 0;
   bool motion_first = false;  ///< candidates[0] is the motion frame's rotation
+  /// The ground vote's extrinsic, when it answered (window_vote.hpp): its lever arm along the
+  /// ground and its height difference. A candidate within vote_agree_deg of its rotation starts
+  /// from this translation instead of the origin (a Tele-15 2.3 m from a VLP-16 lies beyond
+  /// JEEP's start search, which shifts its guess by 2 m: bench_rig, 16-tele).
+  std::optional<Isometry3d> vote;
+  double vote_agree_deg = 0.0;
+
+  /// Where the later stages start from for candidate k.
+  Isometry3d start(std::size_t k) const {
+    Isometry3d t = Isometry3d::Identity();
+    t.linear() = candidates[k].rotation;
+    if (vote && rotation_error_rad(vote->linear(), t.linear()) <= vote_agree_deg * kRadPerDeg)
+      t.translation() = vote->translation();
+    return t;
+  }
 };
 
+/// The ground vote's extrinsic when it was the maps' confident answer.
+inline std::optional<Isometry3d> vote_extrinsic(const std::optional<MotionReport>& m) {
+  if (!m || !m->ok || m->method != "ground vote") return std::nullopt;
+  Isometry3d t = Isometry3d::Identity();
+  t.linear() = m->vote.rotation;
+  t.translation() = m->vote.translation;
+  return t;
+}
+
 inline StartRotations start_rotations(const TerraSearches& searches, TerraSource kept_source,
-                                      const HypothesisOptions& o) {
+                                      const HypothesisOptions& o,
+                                      const MotionFrameOptions& motion = {}) {
   const double separation = o.separation_deg * kRadPerDeg;
   const std::size_t count = std::max<std::size_t>(1, o.count);
   StartRotations out;
+  out.vote = vote_extrinsic(searches.motion);
+  out.vote_agree_deg = motion.vote_agree_deg;
   if (searches.motion_used()) {
     terra::RotationCandidate c;
     c.rotation = searches.motion->rotation;

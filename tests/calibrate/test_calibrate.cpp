@@ -50,13 +50,23 @@ TEST_CASE("terra,jeep recovers the 64-32 mounting with no initial guess", "[cali
   INFO("e_rot " << e.rotation_deg << " deg, e_trans " << e.translation_m << " m");
   CHECK(ulc::is_calibration_success(e));
 
-  // TERRA's rotation is a rotation initialisation, and JEEP started from it with zero translation.
+  // TERRA's rotation is a rotation initialisation; JEEP started from it, with the ground vote's
+  // lever arm when a confident vote backs that rotation (StartRotations::start), else from 0.
   REQUIRE(r.terra);
   REQUIRE(r.jeep);
   CHECK(r.terra->status == terra::SearchStatus::ok);
   CHECK(ulc::rotation_error_rad(truth().linear(), r.terra->rotation) < 10 * kDeg);
   CHECK(r.jeep->initial.linear() == r.terra->rotation);
-  CHECK(r.jeep->initial.translation() == ulc::Vec3d::Zero());
+  const bool vote_backs =
+      r.terra->motion && r.terra->motion->ok && r.terra->motion->method == "ground vote" &&
+      ulc::rotation_error_rad(r.terra->motion->vote.rotation, r.terra->rotation) <= 5.0 * kDeg;
+  if (vote_backs) {
+    CHECK(r.jeep->initial.translation() == r.terra->motion->vote.translation);
+    // The vote's lever arm: on its 0.5 m grid, the height from the two ground planes.
+    CHECK((r.jeep->initial.translation() - truth().translation()).norm() < 0.75);
+  } else {
+    CHECK(r.jeep->initial.translation() == ulc::Vec3d::Zero());
+  }
   CHECK(r.jeep->status == jeep::JeepStatus::ok);
   CHECK(r.jeep->rounds >= 2);
   CHECK(r.jeep->frame_pairs == 5);

@@ -7,6 +7,7 @@
 
 #include "../support/test_units.hpp"
 #include "pipeline/terra_hypotheses.hpp"
+#include "pipeline/terra_stage.hpp"
 
 namespace {
 
@@ -96,4 +97,37 @@ TEST_CASE("the fallback takes the optima not yet tried, in the search's order, o
   terra::SearchResult failed = s;
   failed.status = terra::SearchStatus::no_overlap;
   CHECK(ulc::fallback_hypotheses(failed, {}, 10, 10.0 * kDeg).empty());
+}
+
+TEST_CASE("a hypothesis near a confident ground vote starts from the vote's lever arm",
+          "[calibrate][terra_hypotheses]") {
+  ulc::calibrate_detail::TerraSearches searches;
+  searches.kept = search_with({candidate(3.0, 1.0), candidate(120.0, 2.0)});
+  ulc::MotionReport m;
+  m.ok = true;
+  m.method = "ground vote";
+  m.rotation = yaw(1.0);
+  m.vote.ok = true;
+  m.vote.rotation = yaw(1.0);
+  m.vote.translation = ulc::Vec3d(2.2, 0.5, 0.04);
+  searches.motion = m;
+  ulc::HypothesisOptions h;
+  ulc::MotionFrameOptions o;  // vote_agree_deg 5: the search's 3 deg stands beside the vote
+  const auto starts =
+      ulc::calibrate_detail::start_rotations(searches, ulc::TerraSource::maps, h, o);
+  REQUIRE(starts.candidates.size() >= 2);
+  REQUIRE(starts.vote);
+  // The search's answer (2 deg from the vote) starts from the vote's translation...
+  CHECK(starts.start(0).linear().isApprox(yaw(3.0), 1e-12));
+  CHECK(starts.start(0).translation().isApprox(m.vote.translation, 1e-12));
+  // ...its other optimum, 119 deg away, from the origin.
+  CHECK(starts.start(1).linear().isApprox(yaw(120.0), 1e-12));
+  CHECK(starts.start(1).translation().isZero(0.0));
+
+  // Not the vote's answer (the ground and travel's, or no confident vote): the origin.
+  searches.motion->method = "ground and travel";
+  const auto no_vote =
+      ulc::calibrate_detail::start_rotations(searches, ulc::TerraSource::maps, h, o);
+  CHECK_FALSE(no_vote.vote);
+  CHECK(no_vote.start(0).translation().isZero(0.0));
 }
