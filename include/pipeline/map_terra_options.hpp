@@ -52,8 +52,9 @@ struct MotionFrameOptions {
   double agree_for(const std::string& method) const {
     return method == "ground vote" ? vote_agree_deg : agree_deg;
   }
-  /// The ground vote (terra/ground_vote.hpp: the target's anchor frame against the base's
-  /// map, both levelled on their ground, yaw and lever arm voted for). When it is confident
+  /// The ground vote (terra/ground_vote.hpp: a target frame against the base's map, both
+  /// levelled on their ground, yaw and lever arm voted for; vote_frames of them tallied,
+  /// pipeline/window_vote.hpp). When it is confident
   /// its rotation is the maps' answer, ahead of the ground and travel: it needs no travel and
   /// no target odometry. Measured (bench_terra --windows, 2 s, seeds 1 and 2;
   /// docs/experiments/terra_ground_vote.md).
