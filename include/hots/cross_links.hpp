@@ -41,6 +41,7 @@
 #include "hots/hierarchy.hpp"
 #include "hots/options.hpp"
 #include "ulc/core/batched_for.hpp"
+#include "ulc/core/nearest_time.hpp"
 #include "ulc/core/point_to_plane.hpp"
 #include "ulc/core/registration_target.hpp"
 #include "ulc/core/voxel_downsample.hpp"
@@ -63,13 +64,6 @@ struct CrossLinkStats {
 };
 
 namespace cross_link_detail {
-
-inline std::size_t nearest(const std::vector<double>& member_times, double t) {
-  std::size_t best = 0;
-  for (std::size_t i = 1; i < member_times.size(); ++i)
-    if (std::abs(member_times[i] - t) < std::abs(member_times[best] - t)) best = i;
-  return best;
-}
 
 /// The members of a's layer l that get a link: every one, or every layer0_stride-th at layer 0.
 inline std::vector<std::size_t> chosen_members(std::size_t members, std::size_t l,
@@ -154,7 +148,7 @@ std::vector<CrossLink> cross_links(
         chosen[l].size(), ulc::default_batch_size(),
         [&](std::size_t c) {
           const auto& a = ma[chosen[l][c]];
-          const auto& b = mb[d::nearest(tb, times_a[a.begin])];
+          const auto& b = mb[ulc::nearest_time(tb, times_a[a.begin])];
           const auto& cloud_a = l == 0 ? frames_a[a.begin] : a.cloud;
           const auto& cloud_b = l == 0 ? frames_b[b.begin] : b.cloud;
           const Isometry3d initial = poses_a[a.begin].inverse() * poses_b[b.begin];

@@ -46,6 +46,7 @@
 #include "terra/ground_vote.hpp"
 #include "terra/lattice.hpp"
 #include "terra/search.hpp"
+#include "ulc/core/nearest_time.hpp"
 #include "ulc/core/point_cloud.hpp"
 #include "ulc/core/point_traits.hpp"
 #include "ulc/core/types.hpp"
@@ -179,15 +180,6 @@ std::vector<Vec3<S>> map_at_frame(const LocalMap<S>& map, std::size_t k) {
   return out;
 }
 
-/// The window frame of `times` (from `first`, `count` of them) nearest `t`.
-inline std::size_t nearest_frame(const std::vector<double>& times, std::size_t first,
-                                 std::size_t count, double t) {
-  std::size_t best = 0;
-  for (std::size_t k = 1; k < count; ++k)
-    if (std::fabs(times[first + k] - t) < std::fabs(times[first + best] - t)) best = k;
-  return best;
-}
-
 }  // namespace map_terra_detail
 
 /// The ground vote of a few target window frames against the base's map (window_vote.hpp),
@@ -202,7 +194,7 @@ void add_ground_vote(const LocalMap<SA>& base_map, const std::vector<double>& ti
   const std::vector<std::size_t> voted = vote_frame_indices(target_frames, o.vote_frames, anchor);
   std::vector<terra::GroundVoteResult> votes;
   for (const std::size_t k : voted) {
-    const std::size_t j = nearest_frame(times_a, first, base_map.poses.size(), times_b[first + k]);
+    const std::size_t j = nearest_time(times_a, times_b[first + k], first, base_map.poses.size());
     votes.push_back(terra::ground_vote(map_at_frame(base_map, j), frames_b[first + k], o.vote));
   }
   const VoteTally tally = tally_votes(votes, o.vote_agree_deg);
