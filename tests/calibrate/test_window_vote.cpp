@@ -3,17 +3,18 @@
 #include <catch2/catch.hpp>
 #include <vector>
 
+#include "../support/test_units.hpp"
 #include "pipeline/window_vote.hpp"
 
 namespace {
 
-constexpr double kRad = 3.14159265358979323846 / 180.0;
+using ulc_test::kDeg;
 
 terra::GroundVoteResult vote_about_z(double yaw_deg, bool ok, double score) {
   terra::GroundVoteResult v;
   v.ok = ok;
   v.score = score;
-  v.rotation = Eigen::AngleAxisd(yaw_deg * kRad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  v.rotation = Eigen::AngleAxisd(yaw_deg * kDeg, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   if (!ok) v.reason = "not sure at " + std::to_string(int(yaw_deg));
   return v;
 }

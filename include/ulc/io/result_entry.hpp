@@ -75,11 +75,12 @@ inline Json motion_report(const MotionReport& m) {
   j["used"] = m.used;
   j["method"] = m.method;
   if (m.vote_ran) {
-    j["ground_vote"] = ground_vote_report(m.vote);
-    j["ground_vote"]["window_frame"] = m.vote_frame;
-    j["ground_vote"]["frames_voted"] = m.votes;
-    j["ground_vote"]["frames_confident"] = m.votes_confident;
-    j["ground_vote"]["frames_agreeing"] = m.votes_agreeing;
+    Json vote = ground_vote_report(m.vote);
+    vote["window_frame"] = m.vote_frame;
+    vote["frames_voted"] = m.votes;
+    vote["frames_confident"] = m.votes_confident;
+    vote["frames_agreeing"] = m.votes_agreeing;
+    j["ground_vote"] = std::move(vote);
   }
   return j;
 }
