@@ -45,6 +45,7 @@
 #include "pipeline/window_vote.hpp"
 #include "terra/ground_vote.hpp"
 #include "terra/lattice.hpp"
+#include "terra/ring_gap.hpp"
 #include "terra/search.hpp"
 #include "ulc/core/nearest_time.hpp"
 #include "ulc/core/point_cloud.hpp"
@@ -189,15 +190,18 @@ template <typename SA, class FramesB>
 void add_ground_vote(const LocalMap<SA>& base_map, const std::vector<double>& times_a,
                      const FramesB& frames_b, const std::vector<double>& times_b, std::size_t first,
                      std::size_t target_frames, std::size_t anchor, const MotionFrameOptions& o,
-                     MotionReport& m) {
+                     double base_ring_gap_deg, MotionReport& m) {
   using namespace map_terra_detail;
+  terra::GroundVoteOptions vote_options = o.vote;
+  if (o.fill_base_rings) vote_options.base_ring_gap_deg = base_ring_gap_deg;
   const std::vector<std::size_t> voted = vote_frame_indices(target_frames, o.vote_frames, anchor);
   std::vector<terra::GroundVoteResult> votes;
   for (const std::size_t k : voted) {
     const std::size_t j = nearest_time(times_a, times_b[first + k], first, base_map.poses.size());
-    votes.push_back(terra::ground_vote(map_at_frame(base_map, j), frames_b[first + k], o.vote));
+    votes.push_back(
+        terra::ground_vote(map_at_frame(base_map, j), frames_b[first + k], vote_options));
   }
-  const VoteTally tally = tally_votes(votes, o.vote_agree_deg);
+  const VoteTally tally = tally_votes(votes, o.vote_agree_deg, o.vote.margin_separation_deg);
   m.vote = votes[tally.chosen];
   m.vote_ran = true;
   m.vote_frame = voted[tally.chosen];
@@ -249,7 +253,7 @@ auto build_local_maps(const FramesA& frames_a, const std::vector<double>& times_
       const std::size_t n = maps.b.stats.frames;
       const std::size_t anchor = options.anchor == MapAnchor::last_frame ? n - 1 : 0;
       add_ground_vote(maps.a, times_a, frames_b, times_b, first, n, anchor, options.motion,
-                      maps.motion);
+                      terra::ring_gap_deg(frames_a[first]), maps.motion);
     }
   } else {
     maps.motion.reason = "the motion frame is disabled (MapTerraOptions::motion)";

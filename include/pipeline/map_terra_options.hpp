@@ -64,6 +64,10 @@ struct MotionFrameOptions {
   /// base frame nearest it in time; the answer most confident votes back (window_vote.hpp,
   /// which cites the measurement). 1: the anchor frame alone.
   std::size_t vote_frames = 3;
+  /// The base's ring gap read off its window's first frame (terra/ring_gap.hpp) and filled in
+  /// the vote's base map (GroundVoteOptions::base_ring_gap_deg, which cites the measurement);
+  /// false: vote.base_ring_gap_deg as set.
+  bool fill_base_rings = true;
 };
 
 /// What the motion frame found; `rotation` only when ok.

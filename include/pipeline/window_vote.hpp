@@ -17,8 +17,12 @@
 //   - Tally: each confident vote's support is the number of confident votes within agree_deg of
 //     its rotation (itself included). The window's answer is the vote with the most support
 //     (ties: the higher score, then the earlier frame); none when a confident vote more than
-//     agree_deg away has as much support (two frames sure of different rotations), or when no
-//     vote is confident (then the highest-scoring vote is reported, with its reason).
+//     conflict_deg away has as much support (two frames sure of different rotations: the
+//     street's twin), or when no vote is confident (then the highest-scoring vote is reported,
+//     with its reason). Two frames sure of rotations between agree_deg and conflict_deg apart
+//     back one answer, the higher-scoring: each vote calls rotations within its own
+//     margin_separation_deg (20) one peak; refusing such pairs lost 64-tele and horizon-tele
+//     windows 5-10 deg apart (docs/experiments/terra_ground_vote.md, "A sparse base's rings").
 //   - Nothing here throws or prints; deterministic (every vote is).
 #pragma once
 
@@ -76,7 +80,8 @@ std::size_t best_scoring(const std::vector<terra::GroundVoteResult>& votes, Keep
 
 }  // namespace window_vote_detail
 
-inline VoteTally tally_votes(const std::vector<terra::GroundVoteResult>& votes, double agree_deg) {
+inline VoteTally tally_votes(const std::vector<terra::GroundVoteResult>& votes, double agree_deg,
+                             double conflict_deg) {
   using namespace window_vote_detail;
   VoteTally t;
   if (votes.empty()) return t.reason = "no frame was voted", t;
@@ -93,7 +98,7 @@ inline VoteTally tally_votes(const std::vector<terra::GroundVoteResult>& votes, 
   t.agreeing = *std::max_element(backing.begin(), backing.end());
   t.chosen = best_scoring(votes, [&](std::size_t i) { return backing[i] == t.agreeing; });
   for (std::size_t i = 0; i < votes.size(); ++i)
-    if (backing[i] == t.agreeing && gap_deg(votes[i], votes[t.chosen]) > agree_deg) {
+    if (backing[i] == t.agreeing && gap_deg(votes[i], votes[t.chosen]) > conflict_deg) {
       t.reason = "the window's frames are sure of rotations " +
                  std::to_string(int(gap_deg(votes[i], votes[t.chosen]))) + " deg apart (" +
                  std::to_string(t.agreeing) + " votes each)";

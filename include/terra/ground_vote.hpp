@@ -16,6 +16,9 @@
 //     (horizontal), one per voxel, at most max_points (every k-th of the voxels in key order).
 //     The score of (yaw, tx, ty) is the share of them that land in a voxel the base occupies
 //     after Rz(yaw) and the shift (tx, ty, 0); |tx|, |ty| <= max_translation.
+//   - The base's voxels: each base point's, and those above and below it within half of
+//     base_ring_gap_deg seen from the base (the origin of its cloud): a spinning base's rings
+//     then meet a dense target's points that fell between them.
 //   - Search: yaw over the circle in coarse_step_deg on a grid of twice the voxel, translation
 //     in steps of that voxel; the peaks_per_plane best local maxima (peak_separation_deg
 //     apart) refined in fine_step_deg within one coarse step on the fine grid, translation in
@@ -97,7 +100,12 @@ inline std::vector<ulc::Vec3d> one_per_voxel(const std::vector<ulc::Vec3d>& pts,
 inline OccupancyGrid base_grid(const std::vector<ulc::Vec3d>& base, double voxel,
                                const GroundVoteOptions& o) {
   OccupancyGrid g(voxel, o.max_range + o.max_translation + voxel, o.min_height, o.max_height);
-  for (const ulc::Vec3d& p : base) g.mark(p);
+  // Each base point also fills its column up and down half the ring gap, seen from the anchor.
+  const double slope = std::tan(0.5 * o.base_ring_gap_deg * kRadPerDeg);
+  for (const ulc::Vec3d& p : base) {
+    const int n = static_cast<int>(std::floor(p.head<2>().norm() * slope / voxel + 0.5));
+    for (int k = -n; k <= n; ++k) g.mark(p + ulc::Vec3d(0.0, 0.0, k * voxel));
+  }
   return g;
 }
 
@@ -208,6 +216,8 @@ inline std::string options_problem(const GroundVoteOptions& o) {
         o.fine_step_deg <= o.coarse_step_deg && o.coarse_voxel >= o.voxel &&
         o.max_range / o.voxel < 1e5))
     return "invalid options (voxel, steps, ranges or heights)";
+  if (!(o.base_ring_gap_deg >= 0.0 && o.base_ring_gap_deg <= 30.0))
+    return "invalid options: base_ring_gap_deg must lie in [0, 30] deg";
   // The fine grid's cells (one byte each): bounded, whatever the options ask.
   const double side = 2.0 * (o.max_range + o.max_translation + o.voxel) / o.voxel;
   if (side * side * (o.max_height - o.min_height) / o.voxel > 2e8)
@@ -271,6 +281,7 @@ GroundVoteResult ground_vote(const BaseCloud& base, const TargetCloud& target,
   r.target_plane = w.plane;
   r.base_height = base_planes.front().offset;
   r.target_height = g.plane.offset;
+  r.base_ring_gap_deg = o.base_ring_gap_deg;
   double rival = 0.0;
   for (const auto& [p, share] : refined)
     if (ulc::rotation_error_rad(rotation_of(base_planes.front(), grounds[p.plane].plane, p.yaw_deg),

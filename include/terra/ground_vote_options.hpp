@@ -38,6 +38,12 @@ struct GroundVoteOptions {
   /// The winner's share of votes that landed, at least: 16-tele's VLP-16 map is so sparse
   /// that a wrong yaw won with 5 % of 131 votes (right answers: 12-66 %).
   double min_score = 0.1;
+  /// deg, the base's elevation gap between its rings (ring_gap.hpp; 0: a dense base). A
+  /// VLP-16's 2 deg leave 3.5 m between rings at 100 m, where a Tele-15's returns fall between
+  /// them: at the truth 9-44 % of its votes landed, at the street's twin as many. Half the gap
+  /// is filled up and down from each ring (the whole gap, or 1 deg over a denser base, lost
+  /// windows): docs/experiments/terra_ground_vote.md, "A sparse base's rings".
+  double base_ring_gap_deg = 0.0;
   PlaneFitOptions plane;
 };
 
@@ -51,6 +57,7 @@ struct GroundVoteResult {
   std::size_t points = 0;                         ///< target voxels that voted for the answer
   std::size_t target_plane = 0;                   ///< which of the target's planes was its ground
   double base_height = 0.0, target_height = 0.0;  ///< m, each sensor above its ground
+  double base_ring_gap_deg = 0.0;  ///< the options' gap the base's rings were filled by
 };
 
 }  // namespace terra

@@ -144,6 +144,8 @@ TEST_CASE("the ground vote, or without it the fallback, finds the 90-deg-pitched
         json.at("results")[0].at("stages").at("terra").at("motion").at("ground_vote");
     CHECK(vote.at("frames_voted").get<double>() == double(c.terra->motion->votes));
     CHECK(c.terra->motion->votes == 3);
+    // The base, a VLP-32C, has rings 0.33 deg apart near the horizon (terra/ring_gap.hpp).
+    CHECK(vote.at("base_ring_gap_deg").get<double>() == Approx(0.33).margin(0.1));
     CHECK(vote.at("frames_agreeing").get<double>() >= 1.0);
     CHECK(vote.at("frames_confident").get<double>() >= vote.at("frames_agreeing").get<double>());
     CHECK(vote.at("ok").get<bool>());

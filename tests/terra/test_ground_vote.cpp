@@ -9,6 +9,7 @@
 
 #include "terra/ground_vote.hpp"
 #include "terra/random_rotation.hpp"
+#include "terra/ring_gap.hpp"
 #include "terra_test_util.hpp"
 #include "ulc/core/lie.hpp"
 #include "ulc/core/pose_error.hpp"
@@ -52,6 +53,28 @@ TEST_CASE("the ground vote finds a narrow LiDAR's rotation from one frame",
     // vote's best shift: a narrow view along a street pins it weakly).
     CHECK(std::fabs(v.translation.z() - t_truth.z()) < 0.1);
     CHECK(v.base_height == Approx(2.0).margin(0.05));
+  }
+}
+
+TEST_CASE("the ground vote fills a sparse base's ring gap", "[terra][ground_vote]") {
+  // Sixteen beams over 40 deg: 2.7 deg between rings, 4 m at the wall closing the street
+  // ahead, where the narrow view's points fall between the rings.
+  const auto base = terra_test::scan(ulc::Mat3d::Identity(), ulc::Vec3d::Zero(), 16, 1024);
+  const ulc::Vec3d t_truth(1.3, -0.4, 0.2);
+  terra::SplitMix64 rng(11);
+  for (int k = 0; k < 2; ++k) {
+    const ulc::Mat3d R = terra::random_rotation(rng);
+    const auto target = narrow_scan(R, t_truth, ulc::Vec3d(1.0, 0.09, -0.05), 10.0);
+    terra::GroundVoteOptions filled;
+    filled.base_ring_gap_deg = terra::ring_gap_deg(base);
+    const terra::GroundVoteResult bare = terra::ground_vote(base, target);
+    const terra::GroundVoteResult v = terra::ground_vote(base, target, filled);
+    INFO("bare rings: " << bare.reason << ", score " << bare.score << "; filled: " << v.reason
+                        << ", score " << v.score << ", margin " << v.margin);
+    CHECK_FALSE(bare.ok);  // under 10 % of the votes land between bare rings
+    REQUIRE(v.ok);
+    CHECK(v.base_ring_gap_deg == filled.base_ring_gap_deg);
+    CHECK(ulc::rotation_error_rad(R, v.rotation) / kDeg < 3.0);
   }
 }
 
@@ -108,6 +131,11 @@ TEST_CASE("the ground vote refuses bad input with a reason, never a crash",
   huge.voxel = huge.coarse_voxel = 0.01;
   huge.max_range = 500.0;
   CHECK_THAT(terra::ground_vote(base, base, huge).reason, Catch::Contains("200 MB"));
+  for (const double gap : {-1.0, 31.0, double(NAN)}) {
+    terra::GroundVoteOptions rings;
+    rings.base_ring_gap_deg = gap;
+    CHECK_THAT(terra::ground_vote(base, base, rings).reason, Catch::Contains("base_ring_gap_deg"));
+  }
 }
 
 TEST_CASE("the ground vote gives the same bits on 1 and 2 threads", "[terra][ground_vote]") {

@@ -58,6 +58,7 @@ inline Json ground_vote_report(const terra::GroundVoteResult& v) {
   j["margin"] = std::isfinite(v.margin) ? Json(v.margin) : Json();
   j["points"] = v.points;
   j["target_plane"] = v.target_plane;
+  j["base_ring_gap_deg"] = v.base_ring_gap_deg;
   return j;
 }
 
