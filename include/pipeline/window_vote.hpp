@@ -21,8 +21,9 @@
 //     street's twin), or when no vote is confident (then the highest-scoring vote is reported,
 //     with its reason). Two frames sure of rotations between agree_deg and conflict_deg apart
 //     back one answer, the higher-scoring: each vote calls rotations within its own
-//     margin_separation_deg (20) one peak; refusing such pairs lost 64-tele and horizon-tele
-//     windows 5-10 deg apart (docs/experiments/terra_ground_vote.md, "A sparse base's rings").
+//     margin_separation_deg (20) one peak; refusing such pairs lost 7 windows of the Tele pairs
+//     whose frames were 5-10 deg apart (docs/experiments/terra_ground_vote.md, "A sparse
+//     base's rings").
 //   - Nothing here throws or prints; deterministic (every vote is).
 #pragma once
 
