@@ -183,29 +183,14 @@ std::vector<Vec3<S>> map_at_frame(const LocalMap<S>& map, std::size_t k) {
 
 }  // namespace map_terra_detail
 
-/// The ground vote of a few target window frames against the base's map (window_vote.hpp),
-/// into the motion report: a confident window answer is the maps' rotation, ahead of the
-/// ground and travel's.
-template <typename SA, class FramesB>
-void add_ground_vote(const LocalMap<SA>& base_map, const std::vector<double>& times_a,
-                     const FramesB& frames_b, const std::vector<double>& times_b, std::size_t first,
-                     std::size_t target_frames, std::size_t anchor, const MotionFrameOptions& o,
-                     double base_ring_gap_deg, MotionReport& m) {
-  using namespace map_terra_detail;
-  terra::GroundVoteOptions vote_options = o.vote;
-  if (o.fill_base_rings) vote_options.base_ring_gap_deg = base_ring_gap_deg;
-  const std::vector<std::size_t> voted = vote_frame_indices(target_frames, o.vote_frames, anchor);
-  std::vector<terra::GroundVoteResult> votes;
-  for (const std::size_t k : voted) {
-    const std::size_t j = nearest_time(times_a, times_b[first + k], first, base_map.poses.size());
-    votes.push_back(
-        terra::ground_vote(map_at_frame(base_map, j), frames_b[first + k], vote_options));
-  }
-  const VoteTally tally = tally_votes(votes, o.vote_agree_deg, o.vote.margin_separation_deg);
-  m.vote = votes[tally.chosen];
+/// The window's vote `v` (the tally's answer) into the motion report: a confident one is the
+/// maps' rotation, ahead of the ground and travel's.
+inline void report_vote(const terra::GroundVoteResult& v, const VoteTally& tally, std::size_t frame,
+                        std::size_t frames, MotionReport& m) {
+  m.vote = v;
   m.vote_ran = true;
-  m.vote_frame = voted[tally.chosen];
-  m.votes = votes.size();
+  m.vote_frame = frame;
+  m.votes = frames;
   m.votes_confident = tally.confident;
   m.votes_agreeing = tally.agreeing;
   if (!tally.ok) {
@@ -216,6 +201,39 @@ void add_ground_vote(const LocalMap<SA>& base_map, const std::vector<double>& ti
   m.reason.clear();
   m.rotation = m.vote.rotation;
   m.method = "ground vote";
+}
+
+/// The ground vote of a few target window frames against the base's map (window_vote.hpp),
+/// pooled (MotionFrameOptions::pool_votes) or tallied, into the motion report.
+template <typename SA, class FramesA, class FramesB>
+void add_ground_vote(const LocalMap<SA>& base_map, const FramesA& frames_a,
+                     const std::vector<double>& times_a, const FramesB& frames_b,
+                     const std::vector<double>& times_b, std::size_t first,
+                     std::size_t target_frames, std::size_t anchor, const MotionFrameOptions& o,
+                     double base_ring_gap_deg, MotionReport& m) {
+  using namespace map_terra_detail;
+  terra::GroundVoteOptions vote_options = o.vote;
+  if (o.fill_base_rings) vote_options.base_ring_gap_deg = base_ring_gap_deg;
+  const std::vector<std::size_t> voted = vote_frame_indices(target_frames, o.vote_frames, anchor);
+  if (voted.empty()) return;  // an empty window: nothing to vote on
+  std::vector<terra::GroundVoteInput> inputs;
+  std::vector<terra::GroundVoteResult> votes;
+  for (const std::size_t k : voted) {
+    const std::size_t j = nearest_time(times_a, times_b[first + k], first, base_map.poses.size());
+    inputs.push_back(
+        terra::prepare_ground_vote(map_at_frame(base_map, j), frames_b[first + k], vote_options));
+    votes.push_back(terra::ground_vote(inputs.back(), vote_options));
+    if (o.pool_votes) terra::add_free_space(inputs.back(), frames_a[first + j], vote_options);
+  }
+  const VoteTally tally = tally_votes(votes, o.vote_agree_deg, o.vote.margin_separation_deg);
+  if (!o.pool_votes) {
+    report_vote(votes[tally.chosen], tally, voted[tally.chosen], voted.size(), m);
+    return;
+  }
+  const PooledVote pool = pool_votes(inputs, votes, vote_options);
+  const WindowAnswer answer = window_answer(votes, tally, pool, o.vote.margin_separation_deg);
+  report_vote(answer.vote, answer.tally, voted[answer.tally.chosen], voted.size(), m);
+  m.vote_pooled = answer.pooled;
 }
 
 /// Both LiDARs' local maps over their windows and the motion frame they give, before any search.
@@ -252,8 +270,8 @@ auto build_local_maps(const FramesA& frames_a, const std::vector<double>& times_
     if (options.motion.ground_vote) {
       const std::size_t n = maps.b.stats.frames;
       const std::size_t anchor = options.anchor == MapAnchor::last_frame ? n - 1 : 0;
-      add_ground_vote(maps.a, times_a, frames_b, times_b, first, n, anchor, options.motion,
-                      terra::ring_gap_deg(frames_a[first]), maps.motion);
+      add_ground_vote(maps.a, frames_a, times_a, frames_b, times_b, first, n, anchor,
+                      options.motion, terra::ring_gap_deg(frames_a[first]), maps.motion);
     }
   } else {
     maps.motion.reason = "the motion frame is disabled (MapTerraOptions::motion)";

@@ -28,7 +28,15 @@
 //   - Grounds with fewer than min_points voxels above them do not vote (none left: refused).
 //   - ok (a confident answer) when at least min_score of the votes landed and the margin is at
 //     least min_margin; otherwise the best answer is still filled in, with the reason.
-//   - Result: R = L_b^T Rz(yaw) L_t and t = L_b^T (tx, ty, d_t - d_b).
+//   - Result: R = L_b^T Rz(yaw) L_t and t = L_b^T (tx, ty, d_t - d_b); every refined peak's
+//     pose is kept (GroundVoteResult::peaks) for the window's pooled vote.
+//   - A pose from elsewhere (pose_share): the target ground it turns within pose_tilt_deg of
+//     the base's, its yaw and shift read back through the levellings, then the best share over
+//     yaws within one coarse step and shifts within pose_shift_voxels on the fine grid.
+//   - Free space (add_free_space, optional): the fine voxels a raw base frame's rays crossed,
+//     from its origin to one voxel short of each hit. pose_share counts a point landing there,
+//     and on no surface, as a vote against (a pose's share is never below 0); the single
+//     frame's own search (ground_vote) does not use it.
 //   - Deterministic: per-yaw and per-peak slots filled in parallel, reduced in order; nothing
 //     here throws or prints.
 #pragma once
@@ -117,30 +125,41 @@ struct Peak {
   std::size_t plane = 0;
 };
 
-/// The best shift of the target turned by `yaw_deg`, over steps of the grid's voxel within
-/// max_translation (ties: the first in x then y).
-inline Peak best_shift(const OccupancyGrid& grid, const std::vector<ulc::Vec3d>& target,
-                       double yaw_deg, const GroundVoteOptions& o) {
+/// The best shift of the target turned by `yaw_deg` among (cx + a step, cy + b step),
+/// |a|, |b| <= n, step the grid's voxel (ties: the first in x then y). With `free`, a point
+/// landing in a free voxel the grid does not occupy takes a vote away (none below zero).
+inline Peak best_shift_near(const OccupancyGrid& grid, const std::vector<ulc::Vec3d>& target,
+                            double yaw_deg, double cx, double cy, int n,
+                            const OccupancyGrid* free = nullptr) {
   const double step = grid.voxel();
-  const int n = static_cast<int>(std::floor(o.max_translation / step));
   const int side = 2 * n + 1;
-  std::vector<std::size_t> votes(static_cast<std::size_t>(side * side), 0);
+  std::vector<long> votes(static_cast<std::size_t>(side * side), 0);
   const double c = std::cos(yaw_deg * kRadPerDeg), s = std::sin(yaw_deg * kRadPerDeg);
   for (const ulc::Vec3d& p : target) {
-    const ulc::Vec3d q(c * p.x() - s * p.y(), s * p.x() + c * p.y(), p.z());
+    const ulc::Vec3d q(c * p.x() - s * p.y() + cx, s * p.x() + c * p.y() + cy, p.z());
     for (int a = -n; a <= n; ++a)
-      for (int b = -n; b <= n; ++b)
+      for (int b = -n; b <= n; ++b) {
+        const ulc::Vec3d x = q + ulc::Vec3d(a * step, b * step, 0.0);
         votes[static_cast<std::size_t>((a + n) * side + b + n)] +=
-            grid.occupied(q + ulc::Vec3d(a * step, b * step, 0.0));
+            grid.occupied(x) ? 1 : (free && free->occupied(x) ? -1 : 0);
+      }
   }
   Peak best;
   best.yaw_deg = yaw_deg;
   for (int a = -n; a <= n; ++a)
     for (int b = -n; b <= n; ++b) {
-      const std::size_t v = votes[static_cast<std::size_t>((a + n) * side + b + n)];
-      if (v > best.votes) best.votes = v, best.tx = a * step, best.ty = b * step;
+      const long v = votes[static_cast<std::size_t>((a + n) * side + b + n)];
+      if (v > 0 && std::size_t(v) > best.votes)
+        best.votes = std::size_t(v), best.tx = cx + a * step, best.ty = cy + b * step;
     }
   return best;
+}
+
+/// The best shift within max_translation, in steps of the grid's voxel.
+inline Peak best_shift(const OccupancyGrid& grid, const std::vector<ulc::Vec3d>& target,
+                       double yaw_deg, const GroundVoteOptions& o) {
+  const int n = static_cast<int>(std::floor(o.max_translation / grid.voxel()));
+  return best_shift_near(grid, target, yaw_deg, 0.0, 0.0, n);
 }
 
 /// Each yaw's best shift, for yaws first, first + step, ... (count of them), in parallel.
@@ -218,6 +237,9 @@ inline std::string options_problem(const GroundVoteOptions& o) {
     return "invalid options (voxel, steps, ranges or heights)";
   if (!(o.base_ring_gap_deg >= 0.0 && o.base_ring_gap_deg <= 30.0))
     return "invalid options: base_ring_gap_deg must lie in [0, 30] deg";
+  if (!(o.pose_tilt_deg > 0.0 && o.pose_tilt_deg <= 90.0 && o.pose_shift_voxels <= 20))
+    return "invalid options: pose_tilt_deg must lie in (0, 90] deg and pose_shift_voxels in "
+           "[0, 20]";
   // The fine grid's cells (one byte each): bounded, whatever the options ask.
   const double side = 2.0 * (o.max_range + o.max_translation + o.voxel) / o.voxel;
   if (side * side * (o.max_height - o.min_height) / o.voxel > 2e8)
@@ -228,67 +250,161 @@ inline std::string options_problem(const GroundVoteOptions& o) {
 
 }  // namespace ground_vote_detail
 
-/// R_base_target from the base cloud and one target frame (see the conventions above).
+/// One base cloud and target frame made ready to vote: levelled on their grounds, the target
+/// thinned, the base's grids built. `problem` says why they cannot vote (then nothing else is
+/// filled).
+struct GroundVoteInput {
+  std::string problem;
+  PlaneFit base_plane;
+  std::vector<ground_vote_detail::TargetGround> grounds;
+  std::vector<OccupancyGrid> grids;  ///< coarse, fine
+  /// Fine voxels a base frame's rays crossed before their hit (add_free_space), empty when none
+  /// was given: a pose that puts target points there contradicts what the base saw.
+  std::vector<OccupancyGrid> free;
+};
+
 template <class BaseCloud, class TargetCloud>
-GroundVoteResult ground_vote(const BaseCloud& base, const TargetCloud& target,
-                             const GroundVoteOptions& o = {}) {
+GroundVoteInput prepare_ground_vote(const BaseCloud& base, const TargetCloud& target,
+                                    const GroundVoteOptions& o = {}) {
   using namespace ground_vote_detail;
-  GroundVoteResult r;
-  if (std::string why = options_problem(o); !why.empty()) return r.reason = why, r;
+  GroundVoteInput in;
+  if (std::string why = options_problem(o); !why.empty()) return in.problem = why, in;
   const std::vector<PlaneFit> base_planes = largest_planes(base, 1, o.min_plane_points, o.plane);
-  if (base_planes.empty()) return r.reason = "the base shows no ground plane", r;
-  std::vector<TargetGround> grounds;
+  if (base_planes.empty()) return in.problem = "the base shows no ground plane", in;
+  in.base_plane = base_planes.front();
   for (const PlaneFit& p : largest_planes(target, o.target_planes, o.min_plane_points, o.plane))
-    if (std::fabs(p.offset - base_planes.front().offset) <= o.max_height_difference)
-      grounds.push_back({p, one_per_voxel(levelled(target, p, o), o.voxel, o.max_points)});
-  if (grounds.empty())
-    return r.reason = "none of the target's largest planes lies at the base's ground's height", r;
-  const std::vector<ulc::Vec3d> base_points = levelled(base, base_planes.front(), o);
-  const OccupancyGrid coarse = base_grid(base_points, o.coarse_voxel, o);
-  const OccupancyGrid fine = base_grid(base_points, o.voxel, o);
-  // Coarse sweeps, their best peaks refined; the votes compared as shares of each ground's points.
-  std::vector<std::pair<Peak, double>> refined;  // peak, share
-  const auto steps = static_cast<std::size_t>(std::ceil(360.0 / o.coarse_step_deg));
+    if (std::fabs(p.offset - in.base_plane.offset) <= o.max_height_difference)
+      in.grounds.push_back({p, one_per_voxel(levelled(target, p, o), o.voxel, o.max_points)});
+  if (in.grounds.empty())
+    return in.problem = "none of the target's largest planes lies at the base's ground's height",
+           in;
   // Grounds with too few points above them do not vote (a wall taken for the ground with a
   // handful of points beside it would win on its share).
   std::size_t most = 0;
-  for (const TargetGround& g : grounds) most = std::max(most, g.points.size());
+  for (const TargetGround& g : in.grounds) most = std::max(most, g.points.size());
   if (most < o.min_points)
-    return r.reason = "only " + std::to_string(most) + " target voxels above the ground (" +
-                      std::to_string(o.min_points) + " needed)",
-           r;
-  for (std::size_t j = 0; j < grounds.size(); ++j) {
-    if (grounds[j].points.size() < o.min_points) continue;
-    for (Peak p : best_peaks(sweep(coarse, grounds[j].points, 0.0, o.coarse_step_deg, steps, o),
+    return in.problem = "only " + std::to_string(most) + " target voxels above the ground (" +
+                        std::to_string(o.min_points) + " needed)",
+           in;
+  const std::vector<ulc::Vec3d> base_points = levelled(base, in.base_plane, o);
+  in.grids.push_back(base_grid(base_points, o.coarse_voxel, o));
+  in.grids.push_back(base_grid(base_points, o.voxel, o));
+  return in;
+}
+
+/// Marks the fine voxels `base_frame`'s rays crossed (from its origin to one voxel short of
+/// each hit, at most max_points * 20 rays, every k-th) as free. `base_frame` is a raw frame of
+/// the base in the frame the input's base cloud is in (its origin the sensor's).
+template <class Cloud>
+void add_free_space(GroundVoteInput& in, const Cloud& base_frame, const GroundVoteOptions& o) {
+  if (!in.problem.empty()) return;
+  const ulc::Mat3d L = levelling_rotation(in.base_plane.normal);
+  OccupancyGrid free(o.voxel, o.max_range + o.max_translation + o.voxel, o.min_height,
+                     o.max_height);
+  const ulc::Vec3d origin(0.0, 0.0, in.base_plane.offset);
+  const std::size_t n = ulc::traits::size(base_frame),
+                    rays = 20 * std::max<std::size_t>(1, o.max_points);
+  const std::size_t stride = std::max<std::size_t>(1, (n + rays - 1) / rays);
+  for (std::size_t i = 0; i < n; i += stride) {
+    const ulc::Vec3d p = ulc::traits::point(base_frame, i).template cast<double>();
+    if (!p.allFinite() || p.norm() < o.plane.min_range) continue;
+    ulc::Vec3d q = L * p;
+    q.z() = in.base_plane.normal.dot(p) + in.base_plane.offset;
+    const double length = std::min((q - origin).norm(), o.max_range + o.max_translation);
+    const ulc::Vec3d dir = (q - origin).normalized();
+    for (double t = 0.5 * o.voxel; t < length - o.voxel; t += 0.5 * o.voxel)
+      free.mark(origin + t * dir);
+  }
+  in.free.push_back(std::move(free));
+}
+
+namespace ground_vote_detail {
+
+/// The pose (R_base_target, t_base_target) a levelled peak stands for.
+inline GroundPose pose_of(const GroundVoteInput& in, const Peak& p) {
+  const TargetGround& g = in.grounds[p.plane];
+  const ulc::Vec3d shift(p.tx, p.ty, g.plane.offset - in.base_plane.offset);
+  return {rotation_of(in.base_plane, g.plane, p.yaw_deg),
+          levelling_rotation(in.base_plane.normal).transpose() * shift};
+}
+
+/// Each voting ground's coarse sweep, its best peaks refined, with the share of its points.
+inline std::vector<std::pair<Peak, double>> refined_peaks(const GroundVoteInput& in,
+                                                          const GroundVoteOptions& o) {
+  std::vector<std::pair<Peak, double>> refined;
+  const auto steps = static_cast<std::size_t>(std::ceil(360.0 / o.coarse_step_deg));
+  for (std::size_t j = 0; j < in.grounds.size(); ++j) {
+    const TargetGround& g = in.grounds[j];
+    if (g.points.size() < o.min_points) continue;
+    for (Peak p : best_peaks(sweep(in.grids[0], g.points, 0.0, o.coarse_step_deg, steps, o),
                              o.peaks_per_plane, o.peak_separation_deg)) {
       p.plane = j;
-      const Peak f = refine(fine, grounds[j], p, o);
-      refined.emplace_back(f, double(f.votes) / double(grounds[j].points.size()));
+      const Peak f = refine(in.grids[1], g, p, o);
+      refined.emplace_back(f, double(f.votes) / double(g.points.size()));
     }
   }
+  return refined;
+}
+
+}  // namespace ground_vote_detail
+
+/// The best share of votes of a prepared input near a given pose: the target ground whose
+/// normal the pose turns within pose_tilt_deg of the base's, yaws within one coarse step and
+/// shifts within pose_shift_voxels of the pose's (so that poses found on another frame, on
+/// their own grid, are scored at their best here). 0 when the input cannot vote.
+inline double pose_share(const GroundVoteInput& in, const GroundPose& pose,
+                         const GroundVoteOptions& o) {
+  using namespace ground_vote_detail;
+  if (!in.problem.empty()) return 0.0;
+  const ulc::Mat3d Lb = levelling_rotation(in.base_plane.normal);
+  const ulc::Vec3d shift = Lb * pose.translation;
+  const auto half = static_cast<int>(std::floor(o.coarse_step_deg / o.fine_step_deg));
+  double best = 0.0;
+  for (const TargetGround& g : in.grounds) {
+    if (g.points.size() < o.min_points ||
+        std::acos(std::clamp((pose.rotation * g.plane.normal).dot(in.base_plane.normal), -1.0,
+                             1.0)) > o.pose_tilt_deg * kRadPerDeg)
+      continue;
+    const ulc::Mat3d Z = Lb * pose.rotation * levelling_rotation(g.plane.normal).transpose();
+    const double yaw = std::atan2(Z(1, 0), Z(0, 0)) / kRadPerDeg;
+    for (int k = -half; k <= half; ++k) {
+      const Peak p = best_shift_near(in.grids[1], g.points, yaw + k * o.fine_step_deg, shift.x(),
+                                     shift.y(), static_cast<int>(o.pose_shift_voxels),
+                                     in.free.empty() ? nullptr : &in.free.front());
+      best = std::max(best, double(p.votes) / double(g.points.size()));
+    }
+  }
+  return best;
+}
+
+/// R_base_target from a prepared input (see the conventions above).
+inline GroundVoteResult ground_vote(const GroundVoteInput& in, const GroundVoteOptions& o = {}) {
+  using namespace ground_vote_detail;
+  GroundVoteResult r;
+  if (!in.problem.empty()) return r.reason = in.problem, r;
+  const std::vector<std::pair<Peak, double>> refined = refined_peaks(in, o);
   if (refined.empty()) return r.reason = "no target point above the ground lands on the base", r;
   std::size_t win = 0;
   for (std::size_t k = 1; k < refined.size(); ++k)
     if (refined[k].second > refined[win].second) win = k;
   const Peak& w = refined[win].first;
-  const TargetGround& g = grounds[w.plane];
-  r.rotation = rotation_of(base_planes.front(), g.plane, w.yaw_deg);
-  const double dz = g.plane.offset - base_planes.front().offset;
-  r.translation =
-      levelling_rotation(base_planes.front().normal).transpose() * ulc::Vec3d(w.tx, w.ty, dz);
+  const TargetGround& g = in.grounds[w.plane];
+  const GroundPose best = pose_of(in, w);
+  r.rotation = best.rotation;
+  r.translation = best.translation;
   r.score = refined[win].second;
   r.points = g.points.size();
   r.target_plane = w.plane;
-  r.base_height = base_planes.front().offset;
+  r.base_height = in.base_plane.offset;
   r.target_height = g.plane.offset;
   r.base_ring_gap_deg = o.base_ring_gap_deg;
   double rival = 0.0;
-  for (const auto& [p, share] : refined)
-    if (ulc::rotation_error_rad(rotation_of(base_planes.front(), grounds[p.plane].plane, p.yaw_deg),
-                                r.rotation) /
-            kRadPerDeg >
+  for (const auto& [p, share] : refined) {
+    r.peaks.push_back(pose_of(in, p));
+    if (ulc::rotation_error_rad(r.peaks.back().rotation, r.rotation) / kRadPerDeg >
         o.margin_separation_deg)
       rival = std::max(rival, share);
+  }
   r.margin = rival > 0.0 ? r.score / rival : std::numeric_limits<double>::infinity();
   if (!(r.score >= o.min_score))
     r.reason = "only " + std::to_string(int(100.0 * r.score)) +
@@ -299,6 +415,13 @@ GroundVoteResult ground_vote(const BaseCloud& base, const TargetCloud& target,
                " of the best one's votes";
   r.ok = r.reason.empty();
   return r;
+}
+
+/// R_base_target from the base cloud and one target frame (see the conventions above).
+template <class BaseCloud, class TargetCloud>
+GroundVoteResult ground_vote(const BaseCloud& base, const TargetCloud& target,
+                             const GroundVoteOptions& o = {}) {
+  return ground_vote(prepare_ground_vote(base, target, o), o);
 }
 
 }  // namespace terra

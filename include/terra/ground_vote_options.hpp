@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <string>
+#include <vector>
 
 #include "terra/plane_fit.hpp"
 #include "ulc/core/types.hpp"
@@ -44,7 +45,18 @@ struct GroundVoteOptions {
   /// is filled up and down from each ring (the whole gap, or 1 deg over a denser base, lost
   /// windows): docs/experiments/terra_ground_vote.md, "A sparse base's rings".
   double base_ring_gap_deg = 0.0;
+  /// Scoring a pose found on another frame (pose_share in ground_vote.hpp, the window's pooled
+  /// vote): the target ground it turns within pose_tilt_deg of the base's is voted with yaws
+  /// within one coarse step and shifts within pose_shift_voxels voxels of the pose's.
+  double pose_tilt_deg = 5.0;
+  std::size_t pose_shift_voxels = 2;
   PlaneFitOptions plane;
+};
+
+/// A pose of the target in the base's frame: R_base_target, t_base_target.
+struct GroundPose {
+  ulc::Mat3d rotation = ulc::Mat3d::Identity();
+  ulc::Vec3d translation = ulc::Vec3d::Zero();
 };
 
 struct GroundVoteResult {
@@ -58,6 +70,7 @@ struct GroundVoteResult {
   std::size_t target_plane = 0;                   ///< which of the target's planes was its ground
   double base_height = 0.0, target_height = 0.0;  ///< m, each sensor above its ground
   double base_ring_gap_deg = 0.0;  ///< the options' gap the base's rings were filled by
+  std::vector<GroundPose> peaks;   ///< every refined peak, the answer among them
 };
 
 }  // namespace terra

@@ -148,6 +148,7 @@ TEST_CASE("the ground vote, or without it the fallback, finds the 90-deg-pitched
     CHECK(vote.at("base_ring_gap_deg").get<double>() == Approx(0.33).margin(0.1));
     CHECK(vote.at("frames_agreeing").get<double>() >= 1.0);
     CHECK(vote.at("frames_confident").get<double>() >= vote.at("frames_agreeing").get<double>());
+    CHECK(vote.at("pooled").is_boolean());  // the pool's answer when the tally had none
     CHECK(vote.at("ok").get<bool>());
     REQUIRE((c.success || c.status == CalibrateStatus::uncertain));
     const auto e = ulc::pose_error(truth, c.T_base_target);

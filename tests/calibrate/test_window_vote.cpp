@@ -1,9 +1,13 @@
 // The window's tally of per-frame ground votes (pipeline/window_vote.hpp).
+#include <tbb/task_arena.h>
 #include <Eigen/Geometry>
+
 #include <catch2/catch.hpp>
+#include <cmath>
 #include <vector>
 
 #include "../support/test_units.hpp"
+#include "../terra/terra_test_util.hpp"
 #include "pipeline/window_vote.hpp"
 
 namespace {
@@ -91,5 +95,115 @@ TEST_CASE("the window answers with the rotation most confident frames back",
     const auto t = ulc::tally_votes({}, 5.0, 20.0);
     CHECK_FALSE(t.ok);
     CHECK_FALSE(t.reason.empty());
+  }
+}
+
+namespace {
+
+/// Three views of one narrow LiDAR mount (R, t) over the test street's base scan, each made
+/// ready to vote with the base scan's free space, and their own votes.
+struct Views {
+  std::vector<terra::GroundVoteInput> inputs;
+  std::vector<terra::GroundVoteResult> votes;
+};
+
+Views three_views(const ulc::Mat3d& R, const ulc::Vec3d& t, const std::vector<double>& looks_deg) {
+  const auto base = terra_test::scan(ulc::Mat3d::Identity(), ulc::Vec3d::Zero(), 64, 1024);
+  Views v;
+  for (const double look : looks_deg) {
+    const ulc::Vec3d axis(std::cos(look * kDeg), std::sin(look * kDeg), -0.05);
+    v.inputs.push_back(terra::prepare_ground_vote(base, terra_test::narrow_scan(R, t, axis, 10.0)));
+    v.votes.push_back(terra::ground_vote(v.inputs.back()));
+    terra::add_free_space(v.inputs.back(), base, {});
+  }
+  return v;
+}
+
+}  // namespace
+
+TEST_CASE("the pooled vote scores every frame's peaks on every frame", "[calibrate][window_vote]") {
+  const ulc::Mat3d R = ulc::rotation_from_rpy(0.3, -0.2, 2.4);
+  const ulc::Vec3d t(1.3, -0.4, 0.2);
+  // The mount's view swept 0, 10 and 20 deg to the left along the street, as a turn sweeps
+  // it: the last frame alone is unsure (its best rotation 90 deg off), the pool is not.
+  const Views v = three_views(R, t, {0.0, 10.0, 20.0});
+  CHECK_FALSE(v.votes[2].ok);
+  const ulc::PooledVote pooled = ulc::pool_votes(v.inputs, v.votes, {});
+  INFO(pooled.vote.reason << ", score " << pooled.vote.score << ", margin " << pooled.vote.margin);
+  REQUIRE(pooled.vote.ok);
+  CHECK(ulc::rotation_error_rad(R, pooled.vote.rotation) / kDeg < 3.0);
+  // Its score is the mean share of its pose over the frames; the frames' own votes agree.
+  double mean = 0.0;
+  for (const terra::GroundVoteInput& in : v.inputs)
+    mean += terra::pose_share(in, {pooled.vote.rotation, pooled.vote.translation}, {}) / 3.0;
+  CHECK(pooled.vote.score == Approx(mean));
+  // The same bits on 1 and 2 threads.
+  auto run = [&](int threads) {
+    tbb::task_arena arena(threads);
+    return arena.execute([&] { return ulc::pool_votes(v.inputs, v.votes, {}); });
+  };
+  const ulc::PooledVote one = run(1), two = run(2);
+  CHECK(one.vote.rotation == two.vote.rotation);
+  CHECK(one.vote.score == two.vote.score);
+  CHECK(one.vote.margin == two.vote.margin);
+  CHECK(one.source == two.source);
+}
+
+TEST_CASE("the pooled vote is silent when no frame could vote", "[calibrate][window_vote]") {
+  const std::vector<ulc::Vec3d> empty;
+  const auto base = terra_test::scan(ulc::Mat3d::Identity(), ulc::Vec3d::Zero(), 32, 720);
+  const std::vector<terra::GroundVoteInput> inputs = {terra::prepare_ground_vote(base, empty),
+                                                      terra::prepare_ground_vote(empty, base)};
+  const std::vector<terra::GroundVoteResult> votes = {terra::ground_vote(inputs[0]),
+                                                      terra::ground_vote(inputs[1])};
+  const ulc::PooledVote pooled = ulc::pool_votes(inputs, votes, {});
+  CHECK_FALSE(pooled.vote.ok);
+  CHECK(pooled.vote.reason == votes[0].reason);
+  CHECK_FALSE(ulc::pool_votes({}, {}, {}).vote.ok);
+}
+
+TEST_CASE("the window's answer: the tally's when sure, the pool's when not, none when they differ",
+          "[calibrate][window_vote]") {
+  const std::vector<terra::GroundVoteResult> sure = {vote_about_z(2.0, true, 0.3),
+                                                     vote_about_z(4.0, true, 0.2)};
+  const std::vector<terra::GroundVoteResult> unsure = {vote_about_z(90.0, false, 0.3),
+                                                       vote_about_z(170.0, false, 0.2)};
+  auto pool = [](double yaw_deg, bool ok, std::size_t source) {
+    return ulc::PooledVote{vote_about_z(yaw_deg, ok, 0.25), source};
+  };
+  SECTION("the tally sure, the pool not: the tally's answer") {
+    const auto t = ulc::tally_votes(sure, 5.0, 20.0);
+    const auto a = ulc::window_answer(sure, t, pool(175.0, false, 1), 20.0);
+    CHECK(a.tally.ok);
+    CHECK_FALSE(a.pooled);
+    CHECK(a.vote.rotation == sure[t.chosen].rotation);
+  }
+  SECTION("the tally unsure, the pool sure: the pool's answer and frame") {
+    const auto t = ulc::tally_votes(unsure, 5.0, 20.0);
+    const auto a = ulc::window_answer(unsure, t, pool(3.0, true, 1), 20.0);
+    CHECK(a.tally.ok);
+    CHECK(a.pooled);
+    CHECK(a.tally.chosen == 1);
+    CHECK(ulc::rotation_error_rad(a.vote.rotation, vote_about_z(3.0, true, 0).rotation) < 1e-12);
+  }
+  SECTION("both sure, 173 deg apart: no answer, and why") {
+    const auto t = ulc::tally_votes(sure, 5.0, 20.0);
+    const auto a = ulc::window_answer(sure, t, pool(175.0, true, 0), 20.0);
+    CHECK_FALSE(a.tally.ok);
+    CHECK_THAT(a.tally.reason, Catch::Contains("173 deg apart"));
+  }
+  SECTION("both sure, 10 deg apart: the tally's answer") {
+    const auto t = ulc::tally_votes(sure, 5.0, 20.0);
+    const auto a = ulc::window_answer(sure, t, pool(12.0, true, 0), 20.0);
+    CHECK(a.tally.ok);
+    CHECK_FALSE(a.pooled);
+    CHECK(a.vote.rotation == sure[t.chosen].rotation);
+  }
+  SECTION("neither sure: none, the pool's vote and reason reported") {
+    const auto t = ulc::tally_votes(unsure, 5.0, 20.0);
+    const auto a = ulc::window_answer(unsure, t, pool(60.0, false, 0), 20.0);
+    CHECK_FALSE(a.tally.ok);
+    CHECK(a.pooled);
+    CHECK(a.tally.reason == "not sure at 60");
   }
 }

@@ -109,4 +109,16 @@ inline std::vector<ulc::Vec3d> scan(const ulc::Mat3d& R_scene_lidar,
   return points;
 }
 
+/// A narrow field of view at `position` looking along `axis_scene` (within half_fov_deg of it),
+/// in the sensor's frame turned by R = R_base_target: the dense level scan's points in the cone,
+/// p_target = R^T p_level.
+inline std::vector<ulc::Vec3d> narrow_scan(const ulc::Mat3d& R, const ulc::Vec3d& position,
+                                           const ulc::Vec3d& axis_scene, double half_fov_deg) {
+  const ulc::Vec3d axis = axis_scene.normalized();
+  std::vector<ulc::Vec3d> out;
+  for (const ulc::Vec3d& p : scan(ulc::Mat3d::Identity(), position, 128, 2048))
+    if (p.normalized().dot(axis) > std::cos(half_fov_deg * kDeg)) out.push_back(R.transpose() * p);
+  return out;
+}
+
 }  // namespace terra_test

@@ -16,21 +16,7 @@
 
 using terra_test::kDeg;
 
-namespace {
-
-/// A narrow field of view at `position` looking along `axis_scene` (within half_fov_deg of it),
-/// in the sensor's frame turned by R = R_base_target: the dense level scan's points in the cone,
-/// p_target = R^T p_level.
-std::vector<ulc::Vec3d> narrow_scan(const ulc::Mat3d& R, const ulc::Vec3d& position,
-                                    const ulc::Vec3d& axis_scene, double half_fov_deg) {
-  const ulc::Vec3d axis = axis_scene.normalized();
-  std::vector<ulc::Vec3d> out;
-  for (const ulc::Vec3d& p : terra_test::scan(ulc::Mat3d::Identity(), position, 128, 2048))
-    if (p.normalized().dot(axis) > std::cos(half_fov_deg * kDeg)) out.push_back(R.transpose() * p);
-  return out;
-}
-
-}  // namespace
+using terra_test::narrow_scan;
 
 TEST_CASE("the ground vote finds a narrow LiDAR's rotation from one frame",
           "[terra][ground_vote]") {
@@ -151,4 +137,70 @@ TEST_CASE("the ground vote gives the same bits on 1 and 2 threads", "[terra][gro
   CHECK(one.translation == two.translation);
   CHECK(one.score == two.score);
   CHECK(one.margin == two.margin);
+}
+
+TEST_CASE("a pose is scored on any frame of the mount", "[terra][ground_vote]") {
+  // Two views of one mount (ahead and to the right): the mount's pose gathers on each about
+  // the votes the frame's own answer does, a pose turned 90 deg away far fewer, and the
+  // frame's own answer at least its own share.
+  const auto base = terra_test::scan(ulc::Mat3d::Identity(), ulc::Vec3d::Zero(), 64, 1024);
+  const ulc::Mat3d R = ulc::rotation_from_rpy(0.1, -0.3, 0.8);
+  const terra::GroundPose truth{R, ulc::Vec3d(1.3, -0.4, 0.2)};
+  for (const ulc::Vec3d& look : {ulc::Vec3d(1.0, 0.09, -0.05), ulc::Vec3d(-0.17, -0.98, -0.05)}) {
+    const terra::GroundVoteInput in =
+        terra::prepare_ground_vote(base, narrow_scan(R, truth.translation, look, 10.0));
+    const terra::GroundVoteResult v = terra::ground_vote(in);
+    REQUIRE(v.ok);
+    REQUIRE_FALSE(v.peaks.empty());
+    const double at_truth = terra::pose_share(in, truth, {});
+    INFO("the view's own score " << v.score << ", the mount's pose " << at_truth);
+    CHECK(at_truth > 0.8 * v.score);
+    CHECK(terra::pose_share(in, {v.rotation, v.translation}, {}) >= v.score - 1e-12);
+    terra::GroundPose turned = truth;
+    turned.rotation = Eigen::AngleAxisd(90.0 * kDeg, ulc::Vec3d::UnitZ()) * R;
+    CHECK(terra::pose_share(in, turned, {}) < 0.5 * at_truth);
+    // A pose that tilts the target's ground off the base's is not voted (share 0).
+    terra::GroundPose tilted = truth;
+    tilted.rotation = Eigen::AngleAxisd(0.3, ulc::Vec3d::UnitX()) * R;
+    CHECK(terra::pose_share(in, tilted, {}) == 0.0);
+  }
+  // An input that cannot vote scores nothing.
+  const std::vector<ulc::Vec3d> empty;
+  CHECK(terra::pose_share(terra::prepare_ground_vote(empty, base), truth, {}) == 0.0);
+}
+
+TEST_CASE("the ground vote refuses bad pose-scoring options", "[terra][ground_vote]") {
+  const auto base = terra_test::scan(ulc::Mat3d::Identity(), ulc::Vec3d::Zero(), 32, 720);
+  for (const double tilt : {0.0, 91.0, double(NAN)}) {
+    terra::GroundVoteOptions o;
+    o.pose_tilt_deg = tilt;
+    CHECK_THAT(terra::ground_vote(base, base, o).reason, Catch::Contains("pose_tilt_deg"));
+  }
+  terra::GroundVoteOptions o;
+  o.pose_shift_voxels = 21;
+  CHECK_THAT(terra::prepare_ground_vote(base, base, o).problem, Catch::Contains("pose_shift"));
+}
+
+TEST_CASE("the free space a base frame saw takes votes from poses that put points there",
+          "[terra][ground_vote]") {
+  const auto base = terra_test::scan(ulc::Mat3d::Identity(), ulc::Vec3d::Zero(), 64, 1024);
+  const ulc::Mat3d R = ulc::rotation_from_rpy(-0.2, 0.4, 2.0);
+  const auto target =
+      narrow_scan(R, ulc::Vec3d(1.3, -0.4, 0.2), ulc::Vec3d(1.0, 0.09, -0.05), 10.0);
+  terra::GroundVoteInput in = terra::prepare_ground_vote(base, target);
+  const terra::GroundPose truth{R, ulc::Vec3d(1.3, -0.4, 0.2)};
+  terra::GroundPose turned = truth;
+  turned.rotation = Eigen::AngleAxisd(180.0 * kDeg, ulc::Vec3d::UnitZ()) * truth.rotation;
+  const double truth_bare = terra::pose_share(in, truth, {});
+  const double turned_bare = terra::pose_share(in, turned, {});
+  terra::add_free_space(in, base, {});
+  REQUIRE(in.free.size() == 1);
+  const double truth_free = terra::pose_share(in, truth, {});
+  const double turned_free = terra::pose_share(in, turned, {});
+  INFO("truth " << truth_bare << " -> " << truth_free << ", turned " << turned_bare << " -> "
+                << turned_free);
+  // The mount's points land on what the base saw or where it could not see: little lost.
+  CHECK(truth_free >= 0.9 * truth_bare);
+  // Turned back along the street, they fall into the road the base looked down.
+  CHECK(turned_free < 0.5 * turned_bare + 1e-12);
 }

@@ -81,6 +81,7 @@ inline Json motion_report(const MotionReport& m) {
     vote["frames_voted"] = m.votes;
     vote["frames_confident"] = m.votes_confident;
     vote["frames_agreeing"] = m.votes_agreeing;
+    vote["pooled"] = m.vote_pooled;
     j["ground_vote"] = std::move(vote);
   }
   return j;
