@@ -80,8 +80,11 @@ struct VoteTally {
 
 namespace window_vote_detail {
 
+inline double gap_deg(const Mat3d& a, const Mat3d& b) {
+  return rotation_error_rad(a, b) * 180.0 / 3.14159265358979323846;
+}
 inline double gap_deg(const terra::GroundVoteResult& a, const terra::GroundVoteResult& b) {
-  return rotation_error_rad(a.rotation, b.rotation) * 180.0 / 3.14159265358979323846;
+  return gap_deg(a.rotation, b.rotation);
 }
 
 inline std::size_t support(const std::vector<terra::GroundVoteResult>& votes, std::size_t i,
@@ -157,8 +160,7 @@ inline PooledVote pool_votes(const std::vector<terra::GroundVoteInput>& inputs,
   double rival = 0.0;
   for (std::size_t i = 0; i < peaks.size(); ++i) {
     const terra::GroundPose& p = votes[peaks[i].first].peaks[peaks[i].second];
-    if (rotation_error_rad(p.rotation, best.rotation) * 180.0 / 3.14159265358979323846 >
-        o.margin_separation_deg)
+    if (gap_deg(p.rotation, best.rotation) > o.margin_separation_deg)
       rival = std::max(rival, pooled[i]);
   }
   out.source = peaks[win].first;
@@ -167,15 +169,7 @@ inline PooledVote pool_votes(const std::vector<terra::GroundVoteInput>& inputs,
   v.translation = best.translation;
   v.score = pooled[win];
   v.margin = rival > 0.0 ? v.score / rival : std::numeric_limits<double>::infinity();
-  v.reason.clear();
-  if (!(v.score >= o.min_score))
-    v.reason = "pooled over the window's frames, only " + std::to_string(int(100.0 * v.score)) +
-               " % of the target's votes land on the base's surfaces";
-  else if (!(v.margin >= o.min_margin))
-    v.reason = "pooled over the window's frames, a rotation more than " +
-               std::to_string(int(o.margin_separation_deg)) + " deg away gathers 1/" +
-               std::to_string(v.margin).substr(0, 4) + " of the best one's votes";
-  v.ok = v.reason.empty();
+  terra::judge_vote(v, o, "pooled over the window's frames: ");
   return out;
 }
 

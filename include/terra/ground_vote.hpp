@@ -67,6 +67,14 @@ namespace ground_vote_detail {
 
 constexpr double kRadPerDeg = 3.14159265358979323846 / 180.0;
 
+/// Point `p` levelled on `plane` (see the conventions): turned by the plane's levelling
+/// rotation `L`, its height the signed distance above the plane.
+inline ulc::Vec3d levelled_point(const ulc::Mat3d& L, const PlaneFit& plane, const ulc::Vec3d& p) {
+  ulc::Vec3d q = L * p;
+  q.z() = plane.normal.dot(p) + plane.offset;
+  return q;
+}
+
 /// A cloud's points levelled on `plane` (see the conventions), above the ground and in range.
 template <class Cloud>
 std::vector<ulc::Vec3d> levelled(const Cloud& cloud, const PlaneFit& plane,
@@ -76,8 +84,7 @@ std::vector<ulc::Vec3d> levelled(const Cloud& cloud, const PlaneFit& plane,
   for (std::size_t i = 0; i < ulc::traits::size(cloud); ++i) {
     const ulc::Vec3d p = ulc::traits::point(cloud, i).template cast<double>();
     if (!p.allFinite() || p.norm() < o.plane.min_range) continue;
-    ulc::Vec3d q = L * p;
-    q.z() = plane.normal.dot(p) + plane.offset;
+    const ulc::Vec3d q = levelled_point(L, plane, p);
     if (q.z() >= o.min_height && q.z() < o.max_height && q.head<2>().norm() <= o.max_range)
       out.push_back(q);
   }
@@ -308,8 +315,7 @@ void add_free_space(GroundVoteInput& in, const Cloud& base_frame, const GroundVo
   for (std::size_t i = 0; i < n; i += stride) {
     const ulc::Vec3d p = ulc::traits::point(base_frame, i).template cast<double>();
     if (!p.allFinite() || p.norm() < o.plane.min_range) continue;
-    ulc::Vec3d q = L * p;
-    q.z() = in.base_plane.normal.dot(p) + in.base_plane.offset;
+    const ulc::Vec3d q = ground_vote_detail::levelled_point(L, in.base_plane, p);
     const double length = std::min((q - origin).norm(), o.max_range + o.max_translation);
     const ulc::Vec3d dir = (q - origin).normalized();
     for (double t = 0.5 * o.voxel; t < length - o.voxel; t += 0.5 * o.voxel)
@@ -347,6 +353,21 @@ inline std::vector<std::pair<Peak, double>> refined_peaks(const GroundVoteInput&
 }
 
 }  // namespace ground_vote_detail
+
+/// Sets a vote's verdict from its score and margin: ok when the score reaches min_score and
+/// the margin min_margin, else the reason it is not, after `prefix` (e.g. where it was taken).
+inline void judge_vote(GroundVoteResult& r, const GroundVoteOptions& o,
+                       const std::string& prefix = "") {
+  r.reason.clear();
+  if (!(r.score >= o.min_score))
+    r.reason = prefix + "only " + std::to_string(int(100.0 * r.score)) +
+               " % of the target's votes land on the base's surfaces";
+  else if (!(r.margin >= o.min_margin))
+    r.reason = prefix + "ambiguous: a rotation more than " +
+               std::to_string(int(o.margin_separation_deg)) + " deg away gathers 1/" +
+               std::to_string(r.margin).substr(0, 4) + " of the best one's votes";
+  r.ok = r.reason.empty();
+}
 
 /// The best share of votes of a prepared input near a given pose: the target ground whose
 /// normal the pose turns within pose_tilt_deg of the base's, yaws within one coarse step and
@@ -406,14 +427,7 @@ inline GroundVoteResult ground_vote(const GroundVoteInput& in, const GroundVoteO
       rival = std::max(rival, share);
   }
   r.margin = rival > 0.0 ? r.score / rival : std::numeric_limits<double>::infinity();
-  if (!(r.score >= o.min_score))
-    r.reason = "only " + std::to_string(int(100.0 * r.score)) +
-               " % of the target's votes land on the base's surfaces";
-  else if (!(r.margin >= o.min_margin))
-    r.reason = "ambiguous: a rotation more than " + std::to_string(int(o.margin_separation_deg)) +
-               " deg away gathers 1/" + std::to_string(r.margin).substr(0, 4) +
-               " of the best one's votes";
-  r.ok = r.reason.empty();
+  judge_vote(r, o);
   return r;
 }
 

@@ -171,12 +171,16 @@ TEST_CASE("the window's answer: the tally's when sure, the pool's when not, none
   auto pool = [](double yaw_deg, bool ok, std::size_t source) {
     return ulc::PooledVote{vote_about_z(yaw_deg, ok, 0.25), source};
   };
-  SECTION("the tally sure, the pool not: the tally's answer") {
+  // The sure tally's answer, when the pool is unsure or sure of a rotation within 20 deg of it.
+  auto check_tally_answer = [&](const ulc::PooledVote& pooled) {
     const auto t = ulc::tally_votes(sure, 5.0, 20.0);
-    const auto a = ulc::window_answer(sure, t, pool(175.0, false, 1), 20.0);
+    const auto a = ulc::window_answer(sure, t, pooled, 20.0);
     CHECK(a.tally.ok);
     CHECK_FALSE(a.pooled);
     CHECK(a.vote.rotation == sure[t.chosen].rotation);
+  };
+  SECTION("the tally sure, the pool not: the tally's answer") {
+    check_tally_answer(pool(175.0, false, 1));
   }
   SECTION("the tally unsure, the pool sure: the pool's answer and frame") {
     const auto t = ulc::tally_votes(unsure, 5.0, 20.0);
@@ -193,11 +197,7 @@ TEST_CASE("the window's answer: the tally's when sure, the pool's when not, none
     CHECK_THAT(a.tally.reason, Catch::Contains("173 deg apart"));
   }
   SECTION("both sure, 10 deg apart: the tally's answer") {
-    const auto t = ulc::tally_votes(sure, 5.0, 20.0);
-    const auto a = ulc::window_answer(sure, t, pool(12.0, true, 0), 20.0);
-    CHECK(a.tally.ok);
-    CHECK_FALSE(a.pooled);
-    CHECK(a.vote.rotation == sure[t.chosen].rotation);
+    check_tally_answer(pool(12.0, true, 0));
   }
   SECTION("neither sure: none, the pool's vote and reason reported") {
     const auto t = ulc::tally_votes(unsure, 5.0, 20.0);

@@ -204,3 +204,26 @@ TEST_CASE("the free space a base frame saw takes votes from poses that put point
   // Turned back along the street, they fall into the road the base looked down.
   CHECK(turned_free < 0.5 * turned_bare + 1e-12);
 }
+
+TEST_CASE("a vote's verdict: sure above min_score and min_margin, else why not",
+          "[terra][ground_vote]") {
+  const terra::GroundVoteOptions o;
+  terra::GroundVoteResult r;
+  r.score = o.min_score * 2.0;
+  r.margin = o.min_margin * 2.0;
+  terra::judge_vote(r, o, "here: ");
+  CHECK(r.ok);
+  CHECK(r.reason.empty());
+  r.margin = o.min_margin * 0.9;
+  terra::judge_vote(r, o, "here: ");
+  CHECK_FALSE(r.ok);
+  CHECK_THAT(r.reason, Catch::StartsWith("here: ambiguous"));
+  r.score = o.min_score * 0.5;
+  terra::judge_vote(r, o);
+  CHECK_FALSE(r.ok);
+  CHECK_THAT(r.reason, Catch::StartsWith("only 5 %"));
+  r.score = std::numeric_limits<double>::quiet_NaN();
+  r.margin = o.min_margin * 2.0;
+  terra::judge_vote(r, o);
+  CHECK_FALSE(r.ok);
+}
