@@ -203,6 +203,17 @@ inline void report_vote(const terra::GroundVoteResult& v, const VoteTally& tally
   m.method = "ground vote";
 }
 
+/// The window's unsure pooled vote as the maps' rotation where the ground and travel was
+/// refused (MotionFrameOptions::unsure_vote): when at least `min_score` of its votes landed.
+/// A window whose sure answers conflict (answer.pooled false) stands in nothing.
+inline void stand_in_unsure_vote(const WindowAnswer& answer, double min_score, MotionReport& m) {
+  if (m.ok || answer.tally.ok || !answer.pooled || !(answer.vote.score >= min_score)) return;
+  m.ok = true;
+  m.reason.clear();
+  m.rotation = answer.vote.rotation;
+  m.method = "unsure ground vote";
+}
+
 /// The ground vote of a few target window frames against the base's map (window_vote.hpp),
 /// pooled (MotionFrameOptions::pool_votes) or tallied, into the motion report.
 template <typename SA, class FramesA, class FramesB>
@@ -234,6 +245,7 @@ void add_ground_vote(const LocalMap<SA>& base_map, const FramesA& frames_a,
   const WindowAnswer answer = window_answer(votes, tally, pool, o.vote.margin_separation_deg);
   report_vote(answer.vote, answer.tally, voted[answer.tally.chosen], voted.size(), m);
   m.vote_pooled = answer.pooled;
+  if (o.unsure_vote) stand_in_unsure_vote(answer, vote_options.min_score, m);
 }
 
 /// Both LiDARs' local maps over their windows and the motion frame they give, before any search.

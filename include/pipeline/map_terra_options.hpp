@@ -71,6 +71,13 @@ struct MotionFrameOptions {
   /// 10 deg against 66 / 68 % (docs/experiments/terra_ground_vote.md, "Pooling the window's
   /// frames").
   bool pool_votes = true;
+  /// Where the pooled vote is unsure and the ground and travel refused, the pool's best pose
+  /// (at least vote.min_score of its votes landing) is the maps' rotation, method "unsure
+  /// ground vote" (map_terra.hpp, stand_in_unsure_vote); false: the map search answers there.
+  /// 16-tele, 2 s windows, 50 per seed: 82 / 78 % within 10 deg against 70 / 74 %; it cost
+  /// 32-avia one window of seed 1 (a pool margin of 1.04, where the search was right):
+  /// docs/experiments/terra_ground_vote.md, "An unsure pool as a guess".
+  bool unsure_vote = true;
   /// The base's ring gap read off its window's first frame (terra/ring_gap.hpp) and filled in
   /// the vote's base map (GroundVoteOptions::base_ring_gap_deg, which cites the measurement);
   /// false: vote.base_ring_gap_deg as set.
@@ -89,8 +96,8 @@ struct MotionReport {
   /// it (then it is the first hypothesis).
   double search_off_deg = 0.0;
   bool used = false;
-  /// Where `rotation` came from: "ground vote" (a confident vote), "ground and travel", or
-  /// empty when neither answered.
+  /// Where `rotation` came from: "ground vote" (a confident vote), "ground and travel",
+  /// "unsure ground vote" (MotionFrameOptions::unsure_vote), or empty when none answered.
   std::string method;
   terra::GroundVoteResult vote;  ///< the window's vote (window_vote.hpp), when it ran (vote_ran)
   bool vote_ran = false;

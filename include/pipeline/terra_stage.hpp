@@ -10,7 +10,8 @@
 //   - The motion frame (motion_frame.hpp; not in the paper): whenever the local maps are built
 //     (source maps, or automatic with enough frames in the window: built even when the frames
 //     overlap well, to check them), the maps give a rotation of their own: the ground vote's
-//     when it is confident (terra/ground_vote.hpp), else the ground and travel's.
+//     when it is confident (terra/ground_vote.hpp), else the ground and travel's, else the
+//     unsure pooled vote's best guess (MotionFrameOptions::unsure_vote).
 //     A kept answer within MotionFrameOptions::agree_for(method) of it stands (the paper's search
 //     where it works); a farther one, or a failed search, is overruled: the motion frame's
 //     rotation becomes the stage's answer and the first hypothesis. In automatic, frames that

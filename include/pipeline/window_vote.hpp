@@ -34,12 +34,17 @@
 //     min_score and min_margin. Why: the mount's pose is the same in every frame while the
 //     street's twin moves from frame to frame, and the road a twin puts points on is space the
 //     base saw empty.
-//   - The window's answer (window_answer): the tally's when it is sure, none when the pool is
-//     sure of a rotation more than conflict_deg from it, the pool's when the tally is not sure.
-//     Measured (2 s windows, 50 per seed, seeds 1 / 2, within 10 deg; docs/experiments/
-//     terra_ground_vote.md, "Pooling the window's frames"): 16-tele 70 / 74 % against 66 / 68 %
-//     tallied; the pool alone reached 68 / 74 % there but lost 64-tele windows the tally had
-//     right (84 % against 88 % on seed 1: its margins 1.25-1.4 where the tally was sure).
+//   - The window's answer (window_answer): the tally's when it is sure and the pool's best lies
+//     within conflict_deg of it (sure or not); none when the pool is sure of a rotation farther
+//     off; the pool's when the tally is not sure, or when the pool, unsure, prefers a rotation
+//     farther off (then the window is unsure, the pool's best its guess). Measured (2 s
+//     windows, 50 per seed, seeds 1 / 2, within 10 deg; docs/experiments/terra_ground_vote.md,
+//     "Pooling the window's frames"): 16-tele 70 / 74 % against 66 / 68 % tallied; the pool
+//     alone reached 68 / 74 % there but lost 64-tele windows the tally had right (84 % against
+//     88 % on seed 1: its margins 1.25-1.4 where the tally was sure, its best the tally's).
+//     A sure tally the pool's best contradicts was the street's twin in 16-tele windows 40-42 of
+//     seed 1 (one frame sure of it; the three frames together preferred the truth in two):
+//     docs/experiments/terra_ground_vote.md, "An unsure pool as a guess".
 //   - Nothing here throws or prints; deterministic (every vote is, and the pool's candidates
 //     are scored into slots and reduced in order).
 #pragma once
@@ -217,6 +222,16 @@ inline WindowAnswer window_answer(const std::vector<terra::GroundVoteResult>& vo
     out.vote = pool.vote;
     out.tally.ok = pool.vote.ok;
     out.tally.reason = pool.vote.reason;
+    out.tally.chosen = pool.source;
+    out.pooled = true;
+    return out;
+  }
+  if (!pool.vote.ok && gap_deg(pool.vote, out.vote) > conflict_deg) {
+    out.tally.ok = false;
+    out.tally.reason = "the frames' pool prefers, unsure, a rotation " +
+                       std::to_string(int(gap_deg(pool.vote, out.vote))) +
+                       " deg from their tally's: " + pool.vote.reason;
+    out.vote = pool.vote;
     out.tally.chosen = pool.source;
     out.pooled = true;
     return out;

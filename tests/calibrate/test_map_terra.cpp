@@ -287,8 +287,9 @@ TEST_CASE("the ground vote gives the 64-tele rotation from Tele frames, no targe
                    << m.vote.margin << ", score " << m.vote.score);
     CHECK(m.votes == 3);
     CHECK(m.votes_agreeing <= m.votes_confident);
-    CHECK(m.ok == (m.method == "ground vote"));
-    if (!m.ok) continue;
+    // With the ground and travel refused, only a vote answers: sure, or the unsure pool's guess.
+    CHECK(m.ok == (m.method == "ground vote" || m.method == "unsure ground vote"));
+    if (m.method != "ground vote") continue;
     ++confident;
     CHECK(m.vote.ok);
     CHECK(m.votes_agreeing >= 1);
@@ -298,4 +299,40 @@ TEST_CASE("the ground vote gives the 64-tele rotation from Tele frames, no targe
     CHECK(std::abs(m.vote.target_height - m.vote.base_height + 0.2) < 0.15);
   }
   CHECK(confident >= 1);
+}
+
+TEST_CASE("an unsure pooled vote stands in only where the ground and travel was refused",
+          "[calibrate][map_terra][ground_vote]") {
+  ulc::WindowAnswer unsure;
+  unsure.pooled = true;
+  unsure.tally.ok = false;
+  unsure.vote.score = 0.3;
+  unsure.vote.rotation = Eigen::AngleAxisd(1.0, ulc::Vec3d::UnitZ()).toRotationMatrix();
+  ulc::MotionReport refused;
+  refused.reason = "the rig travelled 0.1 m";
+  SECTION("refused travel, enough votes landed: the pool's guess") {
+    ulc::stand_in_unsure_vote(unsure, 0.1, refused);
+    CHECK(refused.ok);
+    CHECK(refused.method == "unsure ground vote");
+    CHECK(refused.reason.empty());
+    CHECK(refused.rotation == unsure.vote.rotation);
+  }
+  SECTION("too few votes landed: nothing") {
+    ulc::stand_in_unsure_vote(unsure, 0.5, refused);
+    CHECK_FALSE(refused.ok);
+    CHECK(refused.reason == "the rig travelled 0.1 m");
+  }
+  SECTION("sure answers in conflict (not the pool's): nothing") {
+    unsure.pooled = false;
+    ulc::stand_in_unsure_vote(unsure, 0.1, refused);
+    CHECK_FALSE(refused.ok);
+  }
+  SECTION("the ground and travel answered: it stays") {
+    ulc::MotionReport travel;
+    travel.ok = true;
+    travel.method = "ground and travel";
+    ulc::stand_in_unsure_vote(unsure, 0.1, travel);
+    CHECK(travel.method == "ground and travel");
+    CHECK(travel.rotation == ulc::Mat3d::Identity());
+  }
 }

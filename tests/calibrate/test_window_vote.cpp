@@ -179,8 +179,17 @@ TEST_CASE("the window's answer: the tally's when sure, the pool's when not, none
     CHECK_FALSE(a.pooled);
     CHECK(a.vote.rotation == sure[t.chosen].rotation);
   };
-  SECTION("the tally sure, the pool not: the tally's answer") {
-    check_tally_answer(pool(175.0, false, 1));
+  SECTION("the tally sure, the pool not but near it: the tally's answer") {
+    check_tally_answer(pool(15.0, false, 1));
+  }
+  SECTION("the tally sure, the pool unsure of a rotation 173 deg off: unsure, the pool's guess") {
+    const auto t = ulc::tally_votes(sure, 5.0, 20.0);
+    const auto a = ulc::window_answer(sure, t, pool(175.0, false, 1), 20.0);
+    CHECK_FALSE(a.tally.ok);
+    CHECK(a.pooled);
+    CHECK(a.tally.chosen == 1);
+    CHECK_THAT(a.tally.reason, Catch::Contains("173 deg from their tally's: not sure at 175"));
+    CHECK(ulc::rotation_error_rad(a.vote.rotation, vote_about_z(175.0, true, 0).rotation) < 1e-12);
   }
   SECTION("the tally unsure, the pool sure: the pool's answer and frame") {
     const auto t = ulc::tally_votes(unsure, 5.0, 20.0);
