@@ -179,25 +179,25 @@ TEST_CASE("the window's answer: the tally's when sure, the pool's when not, none
     CHECK_FALSE(a.pooled);
     CHECK(a.vote.rotation == sure[t.chosen].rotation);
   };
+  // The pool's answer, sure or not as the pool is, and its frame.
+  auto check_pool_answer = [&](const std::vector<terra::GroundVoteResult>& votes,
+                               const ulc::PooledVote& pooled) {
+    const auto a = ulc::window_answer(votes, ulc::tally_votes(votes, 5.0, 20.0), pooled, 20.0);
+    CHECK(a.tally.ok == pooled.vote.ok);
+    CHECK(a.pooled);
+    CHECK(a.tally.chosen == pooled.source);
+    CHECK(ulc::rotation_error_rad(a.vote.rotation, pooled.vote.rotation) < 1e-12);
+    return a;
+  };
   SECTION("the tally sure, the pool not but near it: the tally's answer") {
     check_tally_answer(pool(15.0, false, 1));
   }
   SECTION("the tally sure, the pool unsure of a rotation 173 deg off: unsure, the pool's guess") {
-    const auto t = ulc::tally_votes(sure, 5.0, 20.0);
-    const auto a = ulc::window_answer(sure, t, pool(175.0, false, 1), 20.0);
-    CHECK_FALSE(a.tally.ok);
-    CHECK(a.pooled);
-    CHECK(a.tally.chosen == 1);
+    const auto a = check_pool_answer(sure, pool(175.0, false, 1));
     CHECK_THAT(a.tally.reason, Catch::Contains("173 deg from their tally's: not sure at 175"));
-    CHECK(ulc::rotation_error_rad(a.vote.rotation, vote_about_z(175.0, true, 0).rotation) < 1e-12);
   }
   SECTION("the tally unsure, the pool sure: the pool's answer and frame") {
-    const auto t = ulc::tally_votes(unsure, 5.0, 20.0);
-    const auto a = ulc::window_answer(unsure, t, pool(3.0, true, 1), 20.0);
-    CHECK(a.tally.ok);
-    CHECK(a.pooled);
-    CHECK(a.tally.chosen == 1);
-    CHECK(ulc::rotation_error_rad(a.vote.rotation, vote_about_z(3.0, true, 0).rotation) < 1e-12);
+    check_pool_answer(unsure, pool(3.0, true, 1));
   }
   SECTION("both sure, 173 deg apart: no answer, and why") {
     const auto t = ulc::tally_votes(sure, 5.0, 20.0);
@@ -209,10 +209,6 @@ TEST_CASE("the window's answer: the tally's when sure, the pool's when not, none
     check_tally_answer(pool(12.0, true, 0));
   }
   SECTION("neither sure: none, the pool's vote and reason reported") {
-    const auto t = ulc::tally_votes(unsure, 5.0, 20.0);
-    const auto a = ulc::window_answer(unsure, t, pool(60.0, false, 0), 20.0);
-    CHECK_FALSE(a.tally.ok);
-    CHECK(a.pooled);
-    CHECK(a.tally.reason == "not sure at 60");
+    CHECK(check_pool_answer(unsure, pool(60.0, false, 0)).tally.reason == "not sure at 60");
   }
 }
