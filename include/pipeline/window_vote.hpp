@@ -218,29 +218,24 @@ inline WindowAnswer window_answer(const std::vector<terra::GroundVoteResult>& vo
                                   double conflict_deg) {
   using namespace window_vote_detail;
   WindowAnswer out{votes.empty() ? pool.vote : votes[tally.chosen], tally, false};
-  if (!tally.ok) {
+  // The pool's vote as the window's, sure or not as `ok` says.
+  const auto pools = [&](bool ok, std::string reason) {
     out.vote = pool.vote;
-    out.tally.ok = pool.vote.ok;
-    out.tally.reason = pool.vote.reason;
+    out.tally.ok = ok;
+    out.tally.reason = std::move(reason);
     out.tally.chosen = pool.source;
     out.pooled = true;
     return out;
-  }
-  if (!pool.vote.ok && gap_deg(pool.vote, out.vote) > conflict_deg) {
-    out.tally.ok = false;
-    out.tally.reason = "the frames' pool prefers, unsure, a rotation " +
-                       std::to_string(int(gap_deg(pool.vote, out.vote))) +
-                       " deg from their tally's: " + pool.vote.reason;
-    out.vote = pool.vote;
-    out.tally.chosen = pool.source;
-    out.pooled = true;
-    return out;
-  }
-  if (pool.vote.ok && gap_deg(pool.vote, out.vote) > conflict_deg) {
-    out.tally.ok = false;
-    out.tally.reason = "the frames' tally and their pool are sure of rotations " +
-                       std::to_string(int(gap_deg(pool.vote, out.vote))) + " deg apart";
-  }
+  };
+  if (!tally.ok) return pools(pool.vote.ok, pool.vote.reason);
+  const double gap = gap_deg(pool.vote, out.vote);
+  if (!(gap > conflict_deg)) return out;
+  const std::string apart = std::to_string(int(gap)) + " deg";
+  if (!pool.vote.ok)
+    return pools(false, "the frames' pool prefers, unsure, a rotation " + apart +
+                            " from their tally's: " + pool.vote.reason);
+  out.tally.ok = false;
+  out.tally.reason = "the frames' tally and their pool are sure of rotations " + apart + " apart";
   return out;
 }
 
