@@ -9,7 +9,7 @@
 # (docs/BENCHMARKS.md).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/install_deps.sh
+bash scripts/install_deps.sh --tests
 jobs=${ULC_JOBS:-$(nproc)}
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DULC_ASSERTIONS=ON -DULC_BUILD_TESTS=ON \
   -DULC_BUILD_APPS=ON -DULC_BUILD_PYTHON=ON -DULC_BUILD_BENCH=OFF -DULC_BUILD_EXAMPLES=OFF
