@@ -28,6 +28,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iostream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -77,6 +78,16 @@ ulc::sim::Dataset simulate(const std::string& scenario, std::uint64_t seed, cons
   return ulc::sim::simulate(*spec, o).dataset;
 }
 
+/// ", free space 0.283 (385 judged)" for a parked answer the check judged
+/// (pipeline/free_space.hpp).
+std::string free_space_note(const ulc::PairCalibration& r) {
+  if (!r.jeep || !r.jeep->free_space) return "";
+  std::ostringstream s;
+  s << ", free space " << r.jeep->free_space->share() << " (" << r.jeep->free_space->judged
+    << " judged)";
+  return s.str();
+}
+
 Outcome calibrate(const ulc::sim::Dataset& d, const ulc::sim::PairTruth& truth, const Config& c) {
   const auto* a = d.find(truth.base);
   const auto* b = d.find(truth.target);
@@ -106,7 +117,7 @@ Outcome calibrate(const ulc::sim::Dataset& d, const ulc::sim::PairTruth& truth, 
                                                            .eigenvalues()
                                                            .maxCoeff())
                                    : -1.0)
-              << " cm\n";
+              << " cm" << free_space_note(r) << "\n";
   return out;
 }
 

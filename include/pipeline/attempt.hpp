@@ -11,6 +11,8 @@
 //     frames still feeds HOTS (its poses are predictions there); one that gives no poses ends
 //     the attempt. With fewer than StageTuning::hots_min_frames frames per LiDAR HOTS is
 //     skipped after TERRA or JEEP (a static snapshot has no motion for it).
+//   - A static snapshot (fewer frames than hots_min_frames): JEEP's answer is also judged by the
+//     free space the base saw (free_space.hpp); refused, the attempt is jeep_failed.
 //   - A failure "points at the start" when JEEP failed or HOTS's cross links refused the
 //     extrinsic (extrinsic_unconfirmed): the next TERRA hypothesis is then worth a try.
 //   - Progress: "jeep", "odometry", "hots", with the attempt's label (" (hypothesis k)").
@@ -18,6 +20,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstddef>
 #include <cstdio>
 #include <memory>
@@ -29,6 +32,7 @@
 #include "hots/hots.hpp"
 #include "jeep/jeep.hpp"
 #include "odometry/run_odometry.hpp"
+#include "pipeline/free_space.hpp"
 #include "pipeline/observability_verdict.hpp"
 #include "pipeline/odometry_choice.hpp"
 #include "pipeline/options.hpp"
@@ -168,6 +172,33 @@ std::optional<StageOutcome> jeep_step(const AttemptInputs<FA, FB>& in, Attempt& 
     at.out.covariance_6x6 = j.covariance_6x6;
   }
   return std::nullopt;
+}
+
+/// The free-space check's refusal, in words.
+inline std::string free_space_refusal(const FreeSpaceVerdict& v, const FreeSpaceOptions& o) {
+  char text[256];
+  std::snprintf(text, sizeof text,
+                "JEEP: its extrinsic puts %.0f %% of the target's judged points (%zu of %zu) where "
+                "the base's rays passed through empty space (at most %.0f %%): a look-alike of the "
+                "scene, not the mount",
+                100.0 * v.share(), v.contradicting, v.judged, 100.0 * o.max_share);
+  return text;
+}
+
+/// A static snapshot's JEEP answer against the free space the base saw (free_space.hpp); an
+/// outcome when it is refused. Not judged when the target moved more than half a voxel between
+/// the two frames (JEEP's target speed times their time gap): the check compares one frame
+/// of each as if taken at one instant.
+template <class FA, class FB>
+std::optional<StageOutcome> free_space_step(const AttemptInputs<FA, FB>& in, Attempt& at) {
+  const FreeSpaceOptions& o = in.options.tuning.free_space;
+  if (!o.enabled || !at.out.jeep || !at.out.jeep->accepted) return std::nullopt;
+  const double gap_s = std::fabs(in.a.times[0] - in.b.times[0]);
+  if (at.out.jeep->target_speed_mps * gap_s > 0.5 * o.voxel) return std::nullopt;
+  const FreeSpaceVerdict v = free_space_verdict(in.a.frames[0], in.b.frames[0], at.extrinsic, o);
+  at.out.jeep->free_space = v;
+  if (v.judged < o.min_points || v.share() <= o.max_share) return std::nullopt;
+  return StageOutcome{CalibrateStatus::jeep_failed, free_space_refusal(v, o), true};
 }
 
 /// A failure after JEEP: when HOTS was judging a failed JEEP, HOTS's refusal is JEEP's failure.
@@ -330,11 +361,14 @@ StageOutcome run_attempt(const AttemptInputs<FA, FB>& in, const Isometry3d& star
                          std::string label, bool hots_may_judge, PairCalibration& out) {
   Attempt at{start, std::move(label), hots_may_judge, {}, out};
   out.T_base_target = start;
-  if (in.run_jeep)
+  const bool snapshot = in.frames_left() < in.options.tuning.hots_min_frames;
+  if (in.run_jeep) {
     if (auto ended = jeep_step(in, at)) return *ended;
+    if (snapshot)
+      if (auto ended = free_space_step(in, at)) return *ended;
+  }
   if (!in.run_hots) return {CalibrateStatus::ok, "", false};
-  if (in.frames_left() < in.options.tuning.hots_min_frames && (in.run_terra || in.run_jeep))
-    return skip_hots(in, at);
+  if (snapshot && (in.run_terra || in.run_jeep)) return skip_hots(in, at);
   return hots_step(in, at);
 }
 

@@ -16,6 +16,7 @@
 #include "hots/options.hpp"
 #include "jeep/options.hpp"
 #include "odometry/options.hpp"
+#include "pipeline/free_space_options.hpp"
 #include "pipeline/hypothesis_options.hpp"
 #include "pipeline/map_terra_options.hpp"
 #include "pipeline/odometry_choice_options.hpp"
@@ -105,6 +106,9 @@ struct StageTuning {
   /// What the data cannot vouch for: an unestimated clock offset, frames without point times
   /// (pipeline/vouch.hpp).
   VouchOptions vouch;
+  /// A static snapshot's JEEP answer is refused when it puts the target's points where the
+  /// base saw through empty space (pipeline/free_space.hpp).
+  FreeSpaceOptions free_space;
 };
 
 /// What a caller of calibrate_pair decides.

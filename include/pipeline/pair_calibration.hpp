@@ -160,6 +160,9 @@ struct JeepReport {
   /// The target's largest speed over the pairs (a's twists carried to b's origin), m/s: what
   /// an unestimated clock offset or an undeskewed sweep turns into a translation error.
   double target_speed_mps = 0.0;
+  /// A static snapshot's answer judged by the free space the base saw (pipeline/free_space.hpp);
+  /// nothing when the check did not run (a moving rig, the check off, JEEP failed).
+  std::optional<FreeSpaceVerdict> free_space;
 };
 
 /// How far the HOTS stage got.

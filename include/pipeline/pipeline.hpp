@@ -115,6 +115,8 @@ InputCheck check_inputs(const FramesA& frames_a, const std::vector<double>& time
     return {CalibrateStatus::invalid_input, "frame and timestamp counts differ"};
   if (options.time_offset_s && !std::isfinite(*options.time_offset_s))
     return {CalibrateStatus::invalid_input, "the known time offset is not finite"};
+  if (std::string why = free_space_problem(options.tuning.free_space); !why.empty())
+    return {CalibrateStatus::invalid_input, why};
   const std::size_t i = options.frame_index;
   if (i >= frames_a.size() || i >= frames_b.size())
     return {CalibrateStatus::invalid_input,

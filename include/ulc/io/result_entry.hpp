@@ -172,6 +172,14 @@ inline Json jeep_to_json(const JeepReport& r) {
   j["shares"] = r.observability ? vector_to_json(r.observability->shares) : Json();
   j["seconds"] = r.seconds;
   j["target_speed_mps"] = r.target_speed_mps;
+  // A static snapshot's free-space check (pipeline/free_space.hpp), null when it did not run.
+  Json free_space;
+  if (r.free_space) {
+    free_space["judged"] = r.free_space->judged;
+    free_space["contradicting"] = r.free_space->contradicting;
+    free_space["share"] = r.free_space->share();
+  }
+  j["free_space"] = std::move(free_space);
   return j;
 }
 

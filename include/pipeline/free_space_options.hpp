@@ -1,0 +1,35 @@
+// The options and the verdict of the free-space check on a static snapshot's answer
+// (pipeline/free_space.hpp). Light: no algorithm.
+#pragma once
+
+#include <cstddef>
+
+namespace ulc {
+
+struct FreeSpaceOptions {
+  bool enabled = true;
+  /// Voxel edge (m) of the base's seen space, and how far from the base it reaches (m): a cube
+  /// of (2 range / voxel)^3 bytes, 13.8 MB at the defaults.
+  double voxel = 0.5;
+  double range = 60.0;
+  /// Every k-th point of the target's frame is judged (deterministic, bounded work).
+  std::size_t stride = 4;
+  /// Fewer judged points than this (target points landing where the base saw something or saw
+  /// through): no verdict, the answer stands.
+  std::size_t min_points = 100;
+  /// An answer that puts more than this share of the judged target points where the base's
+  /// rays passed through empty space is refused. Measured (a probe on every simulated scenario
+  /// parked, seeds 1-10; docs/experiments/free_space_check.md): at the truth 0.000-0.165 (the
+  /// Mid-40s and Avias the highest), at the wrong answers JEEP reached 0.07-0.97, pitched-90
+  /// seed 10's accepted 180-deg twin 0.283.
+  double max_share = 0.25;
+};
+
+/// What the check judged (stages.jeep.free_space).
+struct FreeSpaceVerdict {
+  std::size_t judged = 0;         ///< target points in the base's seen space
+  std::size_t contradicting = 0;  ///< of them, where the base saw through
+  double share() const { return judged ? double(contradicting) / double(judged) : 0.0; }
+};
+
+}  // namespace ulc

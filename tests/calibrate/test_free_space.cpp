@@ -1,0 +1,184 @@
+// The free-space check (pipeline/free_space.hpp): in a closed street canyon the base's rays
+// cross the whole inside, so the target's cloud placed at the truth contradicts nothing, while a
+// target turned or shifted across the street puts its walls where the base saw through; the
+// options are checked. In the pipeline: a parked rig's answer carries the verdict, a parked
+// pitched VLP-16 whose JEEP accepted the scene's twin (seed 10) is refused, and a moving rig is
+// not judged.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "calibrate_test_util.hpp"
+#include "pipeline/calibrate.hpp"
+#include "pipeline/free_space.hpp"
+#include "ulc/core/pose_error.hpp"
+#include "ulc/io/result_entry.hpp"
+
+using namespace calibrate_test;
+using ulc::Isometry3d;
+using ulc::Vec3d;
+
+namespace {
+
+/// The six faces of a closed street canyon (x in [-20, 20] along it, y in [-5, 5], z in
+/// [-2, 10]) on a 0.2 m grid: every ray of a LiDAR inside it comes back.
+std::vector<Vec3d> canyon() {
+  const Vec3d lo(-20.0, -5.0, -2.0), hi(20.0, 5.0, 10.0);
+  std::vector<Vec3d> points;
+  for (int axis = 0; axis < 3; ++axis)
+    for (const double side : {lo[axis], hi[axis]}) {
+      const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+      for (double a = lo[u]; a <= hi[u]; a += 0.2)
+        for (double b = lo[v]; b <= hi[v]; b += 0.2) {
+          Vec3d p;
+          p[axis] = side;
+          p[u] = a;
+          p[v] = b;
+          points.push_back(p);
+        }
+    }
+  return points;
+}
+
+/// The canyon as the target sees it from `T_base_target` (convex: every face in view).
+std::vector<Vec3d> seen_from(const Isometry3d& T_base_target, const std::vector<Vec3d>& scene) {
+  std::vector<Vec3d> out;
+  for (const Vec3d& p : scene) out.push_back(T_base_target.inverse() * p);
+  return out;
+}
+
+Isometry3d mount() {
+  Isometry3d T = Isometry3d::Identity();
+  T.linear() = ulc::so3_exp(Vec3d(0.1, -0.05, 0.4));
+  T.translation() = Vec3d(1.2, 0.6, 0.3);
+  return T;
+}
+
+/// One frame of each LiDAR of `scenario`, parked 5 s into its route.
+ulc::sim::Dataset parked(const std::string& scenario, std::uint64_t seed) {
+  ulc::sim::SimulationOptions o;
+  o.seconds = 0.1;
+  o.seed = seed;
+  o.static_at_s = 5.0;
+  return ulc::sim::simulate(*ulc::sim::scenario(scenario), o).dataset;
+}
+
+ulc::PairCalibration calibrate_first_pair(const ulc::sim::Dataset& d) {
+  const auto& a = d.lidars[0];
+  const auto& b = d.lidars[1];
+  return ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, {});
+}
+
+}  // namespace
+
+TEST_CASE("the free-space check: the truth contradicts nothing, a turned or shifted street does",
+          "[calibrate][free_space]") {
+  const std::vector<Vec3d> scene = canyon();
+  const Isometry3d truth = mount();
+  const std::vector<Vec3d> target = seen_from(truth, scene);
+  const ulc::FreeSpaceOptions o;
+
+  const ulc::FreeSpaceVerdict right = ulc::free_space_verdict(scene, target, truth, o);
+  CHECK(right.judged > 1000);
+  CHECK(right.contradicting == 0);
+
+  // Turned about the vertical by 90 deg (the side walls across the street) and by 180 deg (the
+  // street's twin, about the target rather than the street's centre), or shifted 2 m across
+  // it: the target's walls stand where the base saw through.
+  const auto turned = [&](double deg) {
+    Isometry3d T = truth;
+    T.linear() = ulc::so3_exp(Vec3d(0.0, 0.0, deg * kDeg)) * truth.linear();
+    return T;
+  };
+  Isometry3d across = truth;
+  across.translation() += Vec3d(0.0, 2.0, 0.0);
+  for (const auto& [name, wrong] :
+       {std::pair{"turned 90 deg", turned(90.0)}, std::pair{"turned 180 deg", turned(180.0)},
+        std::pair{"2 m across", across}}) {
+    const ulc::FreeSpaceVerdict v = ulc::free_space_verdict(scene, target, wrong, o);
+    INFO(name << ": " << v.contradicting << " of " << v.judged);
+    CHECK(v.judged > 1000);
+    CHECK(v.share() > o.max_share);
+  }
+
+  // Along the street only the end wall can tell: some contradiction, far less.
+  Isometry3d along = truth;
+  along.translation() += Vec3d(4.0, 0.0, 0.0);
+  const ulc::FreeSpaceVerdict a = ulc::free_space_verdict(scene, target, along, o);
+  CHECK(a.contradicting > 0);
+  CHECK(a.share() < o.max_share);
+
+  SECTION("a point that is not finite is skipped, in either cloud") {
+    std::vector<Vec3d> base_nan = scene, target_nan = target;
+    base_nan.emplace_back(std::numeric_limits<double>::quiet_NaN(), 0.0, 0.0);
+    target_nan.emplace_back(0.0, std::numeric_limits<double>::infinity(), 0.0);
+    const ulc::FreeSpaceVerdict n = ulc::free_space_verdict(base_nan, target_nan, truth, o);
+    CHECK(n.contradicting == 0);
+    CHECK(n.judged >= right.judged);
+  }
+}
+
+TEST_CASE("the free-space options are checked before any allocation", "[calibrate][free_space]") {
+  ulc::FreeSpaceOptions o;
+  CHECK(ulc::free_space_problem(o).empty());
+  o.voxel = 0.0;
+  CHECK_FALSE(ulc::free_space_problem(o).empty());
+  o = {};
+  o.range = 1e9;
+  CHECK_FALSE(ulc::free_space_problem(o).empty());
+  o = {};
+  o.stride = 0;
+  CHECK_FALSE(ulc::free_space_problem(o).empty());
+
+  const ulc::sim::Dataset d = parked("64-32", 1);
+  ulc::CalibrateOptions c;
+  c.tuning.free_space.voxel = std::numeric_limits<double>::quiet_NaN();
+  const auto& a = d.lidars[0];
+  const auto& b = d.lidars[1];
+  const ulc::PairCalibration r =
+      ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, c);
+  CHECK(r.status == ulc::CalibrateStatus::invalid_input);
+  CHECK(r.reason.find("free space") != std::string::npos);
+}
+
+TEST_CASE("a parked rig's answer is judged by the free space the base saw",
+          "[calibrate][free_space]") {
+  SECTION("64-32: right, and the verdict is in the result") {
+    const ulc::sim::Dataset d = parked("64-32", 1);
+    const ulc::PairCalibration r = calibrate_first_pair(d);
+    REQUIRE(r.success);
+    CHECK(ulc::is_calibration_success(ulc::pose_error(d.pairs[0].T_base_target, r.T_base_target)));
+    REQUIRE(r.jeep);
+    REQUIRE(r.jeep->free_space);
+    CHECK(r.jeep->free_space->judged >= ulc::FreeSpaceOptions{}.min_points);
+    CHECK(r.jeep->free_space->share() < 0.05);
+    const auto j = ulc::io::jeep_to_json(*r.jeep);
+    CHECK(j.at("free_space").at("judged").get<std::size_t>() == r.jeep->free_space->judged);
+  }
+  SECTION("pitched-90 seed 10: the twin JEEP accepts is refused") {
+    const ulc::sim::Dataset d = parked("pitched-90", 10);
+    const ulc::PairCalibration r = calibrate_first_pair(d);
+    const auto e = ulc::pose_error(d.pairs[0].T_base_target, r.T_base_target);
+    INFO(ulc::to_string(r.status) << ": " << r.reason << " (" << e.rotation_deg << " deg)");
+    CHECK_FALSE((r.success && !ulc::is_calibration_success(e)));
+    CHECK(r.status == ulc::CalibrateStatus::jeep_failed);
+    CHECK(r.reason.find("empty space") != std::string::npos);
+    REQUIRE(r.jeep);
+    REQUIRE(r.jeep->free_space);
+    CHECK(r.jeep->free_space->share() > ulc::FreeSpaceOptions{}.max_share);
+  }
+  SECTION("a moving rig is not judged by it") {
+    const ulc::sim::Dataset& d = drive_64_32_hots();
+    ulc::CalibrateOptions o;
+    o.stages = {ulc::Stage::terra, ulc::Stage::jeep};
+    const auto& a = d.lidars[0];
+    const auto& b = d.lidars[1];
+    const ulc::PairCalibration r =
+        ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, o);
+    REQUIRE(r.jeep);
+    CHECK_FALSE(r.jeep->free_space);
+  }
+}
