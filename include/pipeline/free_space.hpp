@@ -28,9 +28,9 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
-#include <vector>
 
 #include "pipeline/free_space_options.hpp"
+#include "terra/occupancy_grid.hpp"
 #include "ulc/core/point_traits.hpp"
 #include "ulc/core/types.hpp"
 
@@ -41,75 +41,52 @@ namespace free_space_detail {
 /// 256^3 voxels: the defaults use 240^3.
 constexpr double kMaxCells = 16777216.0;
 
-/// A cube of voxels about the base's origin: unknown, free or occupied.
+/// A cube of voxels about the base's origin (terra::OccupancyGrid, one state byte per voxel):
+/// unknown, free or occupied.
 class SeenSpace {
  public:
   static constexpr std::uint8_t kUnknown = 0, kFree = 1, kOccupied = 2;
 
-  SeenSpace(double voxel, double range)
-      : voxel_(voxel), range_(range), n_(static_cast<std::size_t>(std::ceil(2.0 * range / voxel))) {
-    cells_.assign(n_ * n_ * n_, kUnknown);
-  }
+  SeenSpace(double voxel, double range) : grid_(voxel, range, -range, range), range_(range) {}
 
-  /// Every finite point of `cloud` occupies its voxel and frees those its ray crossed.
+  /// Every finite point of `cloud` occupies its voxel and frees those its ray crossed (an
+  /// occupied voxel stays occupied whichever ray crosses it, before or after).
   template <class Cloud>
   void add_frame(const Cloud& cloud) {
     for (std::size_t i = 0; i < traits::size(cloud); ++i) {
       const Vec3d p = traits::point(cloud, i).template cast<double>();
-      if (p.allFinite()) set(p, kOccupied);
-    }
-    for (std::size_t i = 0; i < traits::size(cloud); ++i) {
-      const Vec3d p = traits::point(cloud, i).template cast<double>();
-      if (p.allFinite()) free_ray(p);
+      if (!p.allFinite()) continue;
+      if (std::uint8_t* c = grid_.cell(p)) *c = kOccupied;
+      free_ray(p);
     }
   }
 
-  std::uint8_t at(const Vec3d& p) const {
-    std::size_t k;
-    return index(p, k) ? cells_[k] : kUnknown;
-  }
+  std::uint8_t at(const Vec3d& p) const { return grid_.value(p); }
 
   bool near_occupied(const Vec3d& p) const {
+    const double v = grid_.voxel();
     for (int dx = -1; dx <= 1; ++dx)
       for (int dy = -1; dy <= 1; ++dy)
         for (int dz = -1; dz <= 1; ++dz)
-          if (at(p + voxel_ * Vec3d(dx, dy, dz)) == kOccupied) return true;
+          if (at(p + v * Vec3d(dx, dy, dz)) == kOccupied) return true;
     return false;
   }
 
  private:
   void free_ray(const Vec3d& hit) {
-    const double r = hit.norm();
-    const double end = std::min(r - 1.5 * voxel_, std::sqrt(3.0) * range_);
+    const double r = hit.norm(), v = grid_.voxel();
     if (!(r > 0.0)) return;
+    const double end = std::min(r - 1.5 * v, std::sqrt(3.0) * range_);
     const Vec3d u = hit / r;
-    for (double t = voxel_; t < end; t += 0.5 * voxel_) {
-      std::size_t k;
-      if (!index(t * u, k)) return;  // left the cube: nothing farther is in it
-      if (cells_[k] == kUnknown) cells_[k] = kFree;
+    for (double t = v; t < end; t += 0.5 * v) {
+      std::uint8_t* c = grid_.cell(t * u);
+      if (!c) return;  // left the cube: nothing farther is in it
+      if (*c == kUnknown) *c = kFree;
     }
   }
 
-  void set(const Vec3d& p, std::uint8_t state) {
-    std::size_t k;
-    if (index(p, k)) cells_[k] = state;
-  }
-
-  bool index(const Vec3d& p, std::size_t& k) const {
-    const double n = static_cast<double>(n_);
-    const double fx = std::floor((p.x() + range_) / voxel_);
-    const double fy = std::floor((p.y() + range_) / voxel_);
-    const double fz = std::floor((p.z() + range_) / voxel_);
-    // Compared as doubles before any cast (a far or NaN coordinate fails here).
-    if (!(fx >= 0.0 && fy >= 0.0 && fz >= 0.0 && fx < n && fy < n && fz < n)) return false;
-    k = (static_cast<std::size_t>(fz) * n_ + static_cast<std::size_t>(fy)) * n_ +
-        static_cast<std::size_t>(fx);
-    return true;
-  }
-
-  double voxel_, range_;
-  std::size_t n_;
-  std::vector<std::uint8_t> cells_;
+  terra::OccupancyGrid grid_;
+  double range_;
 };
 
 }  // namespace free_space_detail
@@ -138,7 +115,7 @@ FreeSpaceVerdict free_space_verdict(const BaseCloud& base, const TargetCloud& ta
     const Vec3d p = T_base_target * traits::point(target, i).template cast<double>();
     if (!p.allFinite()) continue;
     const std::uint8_t state = seen.at(p);
-    const bool near = seen.near_occupied(p);
+    const bool near = state == SeenSpace::kOccupied || seen.near_occupied(p);
     if (state == SeenSpace::kUnknown && !near) continue;
     ++v.judged;
     if (state == SeenSpace::kFree && !near) ++v.contradicting;

@@ -1,6 +1,7 @@
-// A dense occupancy grid over levelled points (x, y about the sensor, z the height above its
-// ground), for the ground vote (ground_vote.hpp): one byte per voxel over a square of
-// 2 * half_extent metres and the heights [min_height, max_height). Built once per search, read
+// A dense grid of one byte per voxel over a square of 2 * half_extent metres about the origin and
+// the heights [min_height, max_height). The ground vote (ground_vote.hpp) marks occupied voxels of
+// levelled points (x, y about the sensor, z the height above its ground); the free-space check
+// (pipeline/free_space.hpp) keeps a state per voxel of a cube about the base. Built once, read
 // millions of times, so lookups are a bounds check and an index.
 #pragma once
 
@@ -28,13 +29,21 @@ class OccupancyGrid {
 
   /// Marks the voxel holding p (ignored outside the grid).
   void mark(const ulc::Vec3d& p) {
-    std::size_t k;
-    if (index(p, k)) cells_[k] = 1;
+    if (std::uint8_t* c = cell(p)) *c = 1;
   }
 
-  bool occupied(const ulc::Vec3d& p) const {
+  bool occupied(const ulc::Vec3d& p) const { return value(p) != 0; }
+
+  /// The byte of the voxel holding p, nullptr outside the grid.
+  std::uint8_t* cell(const ulc::Vec3d& p) {
     std::size_t k;
-    return index(p, k) && cells_[k] != 0;
+    return index(p, k) ? &cells_[k] : nullptr;
+  }
+
+  /// The byte of the voxel holding p; 0 outside the grid.
+  std::uint8_t value(const ulc::Vec3d& p) const {
+    std::size_t k;
+    return index(p, k) ? cells_[k] : 0;
   }
 
  private:
