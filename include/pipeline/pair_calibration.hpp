@@ -89,6 +89,10 @@ struct TerraHypothesis {
   CalibrateStatus status = CalibrateStatus::ok;  ///< how the stages from it ended
   std::string reason;                            ///< why, when status is not ok
   double seconds = 0.0;                          ///< JEEP, odometry and HOTS from this hypothesis
+  /// JEEP's off-ground overlap when JEEP accepted the answer from this hypothesis and the
+  /// free-space check judged and passed it: what a static snapshot's contest compares
+  /// (hypothesis_attempts.hpp).
+  std::optional<double> off_ground_overlap;
 };
 
 /// The TERRA stage: a rotation from one frame of each LiDAR, or from each LiDAR's local map

@@ -43,7 +43,9 @@
 //     next distinct optima run in turn (up to tuning.hypotheses.count); the first success wins.
 //     When all of those fail, up to tuning.hypotheses.fallback more (the kept search's other
 //     optima, then those of the search not kept) run, each needing JEEP's own acceptance before
-//     HOTS. With none, the best one's failure is reported. stages.terra.hypotheses lists each one
+//     HOTS. With none, the best one's failure is reported. On a static snapshot an accepted first
+//     answer meets its rivals instead (tuning.hypotheses.snapshot_rivals; hypothesis_attempts.hpp).
+//     stages.terra.hypotheses lists each one
 //     tried and its outcome; timings sum over all of them. Each starts from its rotation and
 //     translation 0, or from the ground vote's lever arm when it lies within vote_agree_deg of
 //     a confident vote's rotation (StartRotations::start).
@@ -71,6 +73,7 @@
 #include <tbb/task_arena.h>
 
 #include "pipeline/attempt.hpp"
+#include "pipeline/hypothesis_attempts.hpp"
 #include "pipeline/odometry_choice.hpp"
 #include "pipeline/options.hpp"
 #include "pipeline/pair_calibration.hpp"
@@ -84,20 +87,6 @@
 namespace ulc {
 
 namespace calibrate_detail {
-
-/// Ends a call: status, reason and the total time into the result.
-struct Finish {
-  PairCalibration& result;
-  std::chrono::steady_clock::time_point start;
-  PairCalibration operator()(CalibrateStatus status, std::string reason) const {
-    judge_observability(result, status, reason);
-    result.status = status;
-    result.success = status == CalibrateStatus::ok;
-    result.reason = std::move(reason);
-    result.timing_s.total = seconds_since(start);
-    return result;
-  }
-};
 
 /// Why the inputs cannot be calibrated (an empty reason when they can).
 struct InputCheck {
@@ -158,30 +147,6 @@ inline hots::RefineOptions hots_options(const CalibrateOptions& options) {
   return o;
 }
 
-inline TerraHypothesis hypothesis_entry(const terra::RotationCandidate& c, TerraSource source) {
-  TerraHypothesis h;
-  h.source = source;
-  h.rotation = c.rotation;
-  h.distance = c.distance;
-  h.mask_count = c.mask_count;
-  return h;
-}
-
-inline void add_timings(StageTimings& into, const StageTimings& t) {
-  into.jeep += t.jeep;
-  into.odometry += t.odometry;
-  into.hots += t.hots;
-}
-
-/// The stages' reports and outputs of one attempt into the result (timings are summed apart).
-inline void take_stages(PairCalibration& r, const PairCalibration& attempt) {
-  r.jeep = attempt.jeep;
-  r.hots = attempt.hots;
-  r.T_base_target = attempt.T_base_target;
-  r.time_offset_s = attempt.time_offset_s;
-  r.covariance_6x6 = attempt.covariance_6x6;
-}
-
 /// The TERRA stage into r.terra; the rotations to start from, or none when TERRA failed.
 template <class FA, class FB>
 std::optional<StartRotations> terra_step(const FA& frames_a, const std::vector<double>& times_a,
@@ -198,51 +163,6 @@ std::optional<StartRotations> terra_step(const FA& frames_a, const std::vector<d
   if (!searches.ok()) return std::nullopt;
   return start_rotations(searches, r.terra->source, options.tuning.hypotheses,
                          options.tuning.terra_source.maps.motion);
-}
-
-/// TERRA's hypotheses in turn (terra_hypotheses.hpp): when what followed one points at its
-/// rotation (JEEP failed, or HOTS's cross links disagree) and HOTS can judge the next, the next
-/// runs. The first success wins; with none, the best hypothesis's outcome is the answer.
-template <class FA, class FB>
-PairCalibration try_hypotheses(const AttemptInputs<FA, FB>& in, const StartRotations& starts,
-                               PairCalibration& r, const Finish& finish) {
-  PairCalibration first;
-  StageOutcome first_outcome;
-  for (std::size_t k = 0; k < starts.candidates.size(); ++k) {
-    const auto t0 = std::chrono::steady_clock::now();
-    const Isometry3d start = starts.start(k);
-    PairCalibration attempt;
-    attempt.time_offset_s = r.time_offset_s;
-    const std::string label = k == 0 ? "" : " (hypothesis " + std::to_string(k + 1) + ")";
-    const StageOutcome o = run_attempt(in, start, label, k < starts.first_fallback, attempt);
-    TerraHypothesis entry = hypothesis_entry(starts.candidates[k], starts.sources[k]);
-    entry.motion = k == 0 && starts.motion_first;
-    entry.status = o.status;
-    entry.reason = o.reason;
-    entry.seconds = seconds_since(t0);
-    r.terra->hypotheses.push_back(entry);
-    add_timings(r.timing_s, attempt.timing_s);
-    // A failure that does not point at the rotation (the views confirmed it, the clocks'
-    // offset is untrusted, say) is this hypothesis's own answer; so is the best's when no other
-    // can be judged.
-    const bool next_worth_it =
-        in.can_verify() && o.points_at_start && k + 1 < starts.candidates.size();
-    if (o.status == CalibrateStatus::ok || (!next_worth_it && (k == 0 || !o.points_at_start))) {
-      take_stages(r, attempt);
-      r.terra->hypothesis_used = k;
-      return finish(o.status, o.reason);
-    }
-    if (k == 0) {
-      first = std::move(attempt);
-      first_outcome = o;
-    }
-  }
-  take_stages(r, first);
-  r.terra->hypothesis_used = 0;
-  return finish(first_outcome.status,
-                first_outcome.reason + "; TERRA's next " +
-                    std::to_string(r.terra->hypotheses.size() - 1) +
-                    " hypotheses were not confirmed either (stages.terra.hypotheses)");
 }
 
 /// The frames' point-time report before the stages: frames read on demand are counted as the

@@ -43,6 +43,15 @@ inline ulc::sim::Dataset simulate_64_32(double seconds, std::uint64_t seed, unsi
   return ulc::sim::simulate(*ulc::sim::scenario("64-32"), o).dataset;
 }
 
+/// One frame of each LiDAR of `scenario`, parked 5 s into its route: a static snapshot.
+inline ulc::sim::Dataset parked_snapshot(const std::string& scenario, std::uint64_t seed) {
+  ulc::sim::SimulationOptions o;
+  o.seconds = 0.1;
+  o.seed = seed;
+  o.static_at_s = 5.0;
+  return ulc::sim::simulate(*ulc::sim::scenario(scenario), o).dataset;
+}
+
 /// Six frames of each LiDAR of the 64-32 rig, the first 0.6 s of the town drive.
 inline const ulc::sim::Dataset& drive_64_32() {
   static const ulc::sim::Dataset d = simulate_64_32(0.6, 1, 2);

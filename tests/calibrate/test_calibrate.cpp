@@ -50,16 +50,20 @@ TEST_CASE("terra,jeep recovers the 64-32 mounting with no initial guess", "[cali
   INFO("e_rot " << e.rotation_deg << " deg, e_trans " << e.translation_m << " m");
   CHECK(ulc::is_calibration_success(e));
 
-  // TERRA's rotation is a rotation initialisation; JEEP started from it, with the ground vote's
-  // lever arm when a confident vote backs that rotation (StartRotations::start), else from 0.
+  // TERRA's rotation is a rotation initialisation; JEEP started from it (or from a later
+  // hypothesis that won the snapshot's contest, pipeline/hypothesis_attempts.hpp: the frames are
+  // taken together, so the free-space check judges them), with the ground vote's lever arm when
+  // a confident vote backs that rotation (StartRotations::start), else from 0.
   REQUIRE(r.terra);
   REQUIRE(r.jeep);
   CHECK(r.terra->status == terra::SearchStatus::ok);
   CHECK(ulc::rotation_error_rad(truth().linear(), r.terra->rotation) < 10 * kDeg);
-  CHECK(r.jeep->initial.linear() == r.terra->rotation);
+  REQUIRE(r.terra->hypothesis_used < r.terra->hypotheses.size());
+  const ulc::Mat3d& start = r.terra->hypotheses[r.terra->hypothesis_used].rotation;
+  CHECK(r.jeep->initial.linear() == start);
   const bool vote_backs =
       r.terra->motion && r.terra->motion->ok && r.terra->motion->method == "ground vote" &&
-      ulc::rotation_error_rad(r.terra->motion->vote.rotation, r.terra->rotation) <= 5.0 * kDeg;
+      ulc::rotation_error_rad(r.terra->motion->vote.rotation, start) <= 5.0 * kDeg;
   if (vote_backs) {
     CHECK(r.jeep->initial.translation() == r.terra->motion->vote.translation);
     // The vote's lever arm: on its 0.5 m grid, the height from the two ground planes.
@@ -75,10 +79,12 @@ TEST_CASE("terra,jeep recovers the 64-32 mounting with no initial guess", "[cali
   CHECK(r.terra->base_points == base().frames[0].size());
   CHECK(r.terra->target_points == target().frames[0].size());
 
-  // Progress: terra's calls, then jeep's, each in [0, 1], nondecreasing, ending at 1.
+  // Progress: terra's calls, then jeep's (each hypothesis's), each in [0, 1], nondecreasing,
+  // ending at 1.
+  const auto is_jeep = [](const std::string& stage) { return stage.rfind("jeep", 0) == 0; };
   REQUIRE(!calls.empty());
   CHECK(calls.front().stage == "terra");
-  CHECK(calls.back().stage == "jeep");
+  CHECK(is_jeep(calls.back().stage));
   CHECK(calls.back().fraction == 1.0);
   for (std::size_t k = 0; k < calls.size(); ++k) {
     CHECK(calls[k].fraction >= 0.0);
@@ -87,7 +93,7 @@ TEST_CASE("terra,jeep recovers the 64-32 mounting with no initial guess", "[cali
       CHECK(calls[k].fraction >= calls[k - 1].fraction);
     if (k > 0 && calls[k].stage != calls[k - 1].stage) {
       CHECK(calls[k - 1].fraction == 1.0);  // a stage finishes before the next begins
-      CHECK(calls[k].stage == "jeep");
+      CHECK(is_jeep(calls[k].stage));
     }
   }
 }

@@ -57,15 +57,6 @@ Isometry3d mount() {
   return T;
 }
 
-/// One frame of each LiDAR of `scenario`, parked 5 s into its route.
-ulc::sim::Dataset parked(const std::string& scenario, std::uint64_t seed) {
-  ulc::sim::SimulationOptions o;
-  o.seconds = 0.1;
-  o.seed = seed;
-  o.static_at_s = 5.0;
-  return ulc::sim::simulate(*ulc::sim::scenario(scenario), o).dataset;
-}
-
 ulc::PairCalibration calibrate_first_pair(const ulc::sim::Dataset& d) {
   const auto& a = d.lidars[0];
   const auto& b = d.lidars[1];
@@ -133,7 +124,7 @@ TEST_CASE("the free-space options are checked before any allocation", "[calibrat
   o.stride = 0;
   CHECK_FALSE(ulc::free_space_problem(o).empty());
 
-  const ulc::sim::Dataset d = parked("64-32", 1);
+  const ulc::sim::Dataset d = parked_snapshot("64-32", 1);
   ulc::CalibrateOptions c;
   c.tuning.free_space.voxel = std::numeric_limits<double>::quiet_NaN();
   const auto& a = d.lidars[0];
@@ -147,7 +138,7 @@ TEST_CASE("the free-space options are checked before any allocation", "[calibrat
 TEST_CASE("a parked rig's answer is judged by the free space the base saw",
           "[calibrate][free_space]") {
   SECTION("64-32: right, and the verdict is in the result") {
-    const ulc::sim::Dataset d = parked("64-32", 1);
+    const ulc::sim::Dataset d = parked_snapshot("64-32", 1);
     const ulc::PairCalibration r = calibrate_first_pair(d);
     REQUIRE(r.success);
     CHECK(ulc::is_calibration_success(ulc::pose_error(d.pairs[0].T_base_target, r.T_base_target)));
@@ -159,7 +150,7 @@ TEST_CASE("a parked rig's answer is judged by the free space the base saw",
     CHECK(j.at("free_space").at("judged").get<std::size_t>() == r.jeep->free_space->judged);
   }
   SECTION("pitched-90 seed 10: the twin JEEP accepts is refused") {
-    const ulc::sim::Dataset d = parked("pitched-90", 10);
+    const ulc::sim::Dataset d = parked_snapshot("pitched-90", 10);
     const ulc::PairCalibration r = calibrate_first_pair(d);
     const auto e = ulc::pose_error(d.pairs[0].T_base_target, r.T_base_target);
     INFO(ulc::to_string(r.status) << ": " << r.reason << " (" << e.rotation_deg << " deg)");

@@ -137,6 +137,7 @@ inline Json terra_to_json(const TerraReport& t) {
                        ? std::string("ok")
                        : std::string(to_string(h.status)) + ": " + h.reason;
     e["seconds"] = h.seconds;
+    if (h.off_ground_overlap) e["off_ground_overlap"] = *h.off_ground_overlap;
     hypotheses.push_back(std::move(e));
   }
   j["hypotheses"] = std::move(hypotheses);
