@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "terra/random_rotation.hpp"
+#include "ulc/core/angles.hpp"
 #include "ulc/core/kdtree.hpp"
 #include "ulc/core/normals.hpp"
 #include "ulc/core/voxel_downsample.hpp"
@@ -46,7 +47,6 @@ struct Options {
 };
 
 constexpr int kBins = 11;
-constexpr double kPi = 3.14159265358979323846;
 using Feature = std::array<float, 3 * kBins>;
 
 /// A frame reduced to what the baseline matches: points, normals and their features.
@@ -86,8 +86,8 @@ inline Feature spfh(const Described& d, std::size_t i, const std::vector<std::si
     const Vec3d& nt = d.normals[j];
     h[static_cast<std::size_t>(bin(vn.dot(nt), -1.0, 1.0))] += 1.0f;
     h[static_cast<std::size_t>(kBins + bin(u.dot(step), -1.0, 1.0))] += 1.0f;
-    h[static_cast<std::size_t>(2 * kBins + bin(std::atan2(w.dot(nt), u.dot(nt)), -kPi, kPi))] +=
-        1.0f;
+    h[static_cast<std::size_t>(2 * kBins +
+                               bin(std::atan2(w.dot(nt), u.dot(nt)), -ulc::kPi, ulc::kPi))] += 1.0f;
     ++used;
   }
   if (used > 0)

@@ -22,12 +22,12 @@
 
 #include "support/png_canvas.hpp"
 #include "terra/terra.hpp"
+#include "ulc/core/angles.hpp"
 #include "ulc/core/pose_error.hpp"
 
 namespace terra_landscape {
 
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kDeg = kPi / 180.0;
+constexpr double kDeg = ulc::kRadPerDeg;
 
 /// The grid: yaw and roll in [-180, 180), pitch in [-90, 90], every `step` degrees.
 struct Grid {

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "odometry/options.hpp"
+#include "ulc/core/angles.hpp"
 #include "ulc/core/registration_types.hpp"
 
 namespace jeep {
@@ -84,14 +85,14 @@ struct ScanScanOptions {
 
 struct StartSearchOptions {
   bool enabled = true;
-  double rotation_step = 5.0 * 3.14159265358979323846 / 180.0;  ///< rad, the paper's disturbance
-  double translation_step = 2.0;                                ///< m, the paper's disturbance
-  double same_basin_rotation = 1.0 * 3.14159265358979323846 / 180.0;  ///< rad
-  double same_basin_translation = 0.3;                                ///< m
+  double rotation_step = 5.0 * ulc::kPi / 180.0;        ///< rad, the paper's disturbance
+  double translation_step = 2.0;                        ///< m, the paper's disturbance
+  double same_basin_rotation = 1.0 * ulc::kPi / 180.0;  ///< rad
+  double same_basin_translation = 0.3;                  ///< m
   /// Basins further than this from the initial extrinsic are not candidates: the initial
   /// guess is trusted to within twice the paper's disturbance.
-  double reach_rotation = 10.0 * 3.14159265358979323846 / 180.0;  ///< rad
-  double reach_translation = 5.0;                                 ///< m
+  double reach_rotation = 10.0 * ulc::kPi / 180.0;  ///< rad
+  double reach_translation = 5.0;                   ///< m
 };
 
 struct JeepOptions {

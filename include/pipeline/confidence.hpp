@@ -37,6 +37,7 @@
 
 #include "pipeline/pair_calibration.hpp"
 #include "pipeline/vouch_options.hpp"
+#include "ulc/core/angles.hpp"
 #include "ulc/core/observability.hpp"
 #include "ulc/core/types.hpp"
 
@@ -93,8 +94,8 @@ inline std::string loosely_pinned(const PairCalibration& r, const VouchOptions& 
   const Mat6d& c = *r.covariance_6x6;
   const LooseClaim t = loose_claim(c.topLeftCorner<3, 3>(), v.success_translation_m * 100.0, 100.0,
                                    "cm", "along", 0);
-  const LooseClaim a = loose_claim(c.bottomRightCorner<3, 3>(), v.success_rotation_deg,
-                                   180.0 / 3.14159265358979323846, "deg", "about", 1);
+  const LooseClaim a = loose_claim(c.bottomRightCorner<3, 3>(), v.success_rotation_deg, kDegPerRad,
+                                   "deg", "about", 1);
   const LooseClaim& loose = t.chance >= a.chance ? t : a;
   if (loose.chance <= v.max_beyond_probability) return "";
   return "the result's covariance gives a " + percent(loose.chance) + " chance that it is " +

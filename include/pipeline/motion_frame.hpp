@@ -36,6 +36,7 @@
 
 #include "pipeline/map_terra_options.hpp"
 #include "terra/plane_fit.hpp"
+#include "ulc/core/angles.hpp"
 #include "ulc/core/types.hpp"
 
 namespace ulc {
@@ -48,8 +49,6 @@ struct MotionView {
 };
 
 namespace motion_detail {
-
-constexpr double kRadPerDeg = 3.14159265358979323846 / 180.0;
 
 inline double angle_deg(const Vec3d& a, const Vec3d& b) {
   return std::atan2(a.cross(b).norm(), a.dot(b)) / kRadPerDeg;

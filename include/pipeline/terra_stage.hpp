@@ -38,13 +38,12 @@
 #include "pipeline/pair_calibration.hpp"
 #include "pipeline/terra_hypotheses.hpp"
 #include "terra/search.hpp"
+#include "ulc/core/angles.hpp"
 #include "ulc/core/point_traits.hpp"
 #include "ulc/core/pose_error.hpp"
 
 namespace ulc {
 namespace calibrate_detail {
-
-constexpr double kRadPerDeg = 3.14159265358979323846 / 180.0;
 
 /// What the TERRA stage reads, and the decisions made before any search.
 template <class FramesA, class FramesB>

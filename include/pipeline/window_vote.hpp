@@ -59,6 +59,7 @@
 #include <tbb/parallel_for.h>
 
 #include "terra/ground_vote.hpp"
+#include "ulc/core/angles.hpp"
 #include "ulc/core/pose_error.hpp"
 
 namespace ulc {
@@ -86,7 +87,7 @@ struct VoteTally {
 namespace window_vote_detail {
 
 inline double gap_deg(const Mat3d& a, const Mat3d& b) {
-  return rotation_error_rad(a, b) * 180.0 / 3.14159265358979323846;
+  return rotation_error_rad(a, b) * 180.0 / kPi;
 }
 inline double gap_deg(const terra::GroundVoteResult& a, const terra::GroundVoteResult& b) {
   return gap_deg(a.rotation, b.rotation);

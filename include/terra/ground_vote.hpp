@@ -56,6 +56,7 @@
 #include "terra/occupancy_grid.hpp"
 #include "terra/plane_fit.hpp"
 #include "terra/scan_context.hpp"
+#include "ulc/core/angles.hpp"
 #include "ulc/core/point_traits.hpp"
 #include "ulc/core/pose_error.hpp"
 #include "ulc/core/types.hpp"
@@ -64,8 +65,6 @@
 namespace terra {
 
 namespace ground_vote_detail {
-
-constexpr double kRadPerDeg = 3.14159265358979323846 / 180.0;
 
 /// Point `p` levelled on `plane` (see the conventions): turned by the plane's levelling
 /// rotation `L`, its height the signed distance above the plane.
@@ -116,7 +115,7 @@ inline OccupancyGrid base_grid(const std::vector<ulc::Vec3d>& base, double voxel
                                const GroundVoteOptions& o) {
   OccupancyGrid g(voxel, o.max_range + o.max_translation + voxel, o.min_height, o.max_height);
   // Each base point also fills its column up and down half the ring gap, seen from the anchor.
-  const double slope = std::tan(0.5 * o.base_ring_gap_deg * kRadPerDeg);
+  const double slope = std::tan(0.5 * o.base_ring_gap_deg * ulc::kRadPerDeg);
   for (const ulc::Vec3d& p : base) {
     const int n = static_cast<int>(std::floor(p.head<2>().norm() * slope / voxel + 0.5));
     for (int k = -n; k <= n; ++k) g.mark(p + ulc::Vec3d(0.0, 0.0, k * voxel));
@@ -141,7 +140,7 @@ inline Peak best_shift_near(const OccupancyGrid& grid, const std::vector<ulc::Ve
   const double step = grid.voxel();
   const int side = 2 * n + 1;
   std::vector<long> votes(static_cast<std::size_t>(side * side), 0);
-  const double c = std::cos(yaw_deg * kRadPerDeg), s = std::sin(yaw_deg * kRadPerDeg);
+  const double c = std::cos(yaw_deg * ulc::kRadPerDeg), s = std::sin(yaw_deg * ulc::kRadPerDeg);
   for (const ulc::Vec3d& p : target) {
     const ulc::Vec3d q(c * p.x() - s * p.y() + cx, s * p.x() + c * p.y() + cy, p.z());
     for (int a = -n; a <= n; ++a)
@@ -231,7 +230,7 @@ inline Peak refine(const OccupancyGrid& fine, const TargetGround& t, const Peak&
 
 inline ulc::Mat3d rotation_of(const PlaneFit& base, const PlaneFit& target, double yaw_deg) {
   return levelling_rotation(base.normal).transpose() *
-         Eigen::AngleAxisd(yaw_deg * kRadPerDeg, ulc::Vec3d::UnitZ()).toRotationMatrix() *
+         Eigen::AngleAxisd(yaw_deg * ulc::kRadPerDeg, ulc::Vec3d::UnitZ()).toRotationMatrix() *
          levelling_rotation(target.normal);
 }
 
@@ -384,10 +383,10 @@ inline double pose_share(const GroundVoteInput& in, const GroundPose& pose,
   for (const TargetGround& g : in.grounds) {
     if (g.points.size() < o.min_points ||
         std::acos(std::clamp((pose.rotation * g.plane.normal).dot(in.base_plane.normal), -1.0,
-                             1.0)) > o.pose_tilt_deg * kRadPerDeg)
+                             1.0)) > o.pose_tilt_deg * ulc::kRadPerDeg)
       continue;
     const ulc::Mat3d Z = Lb * pose.rotation * levelling_rotation(g.plane.normal).transpose();
-    const double yaw = std::atan2(Z(1, 0), Z(0, 0)) / kRadPerDeg;
+    const double yaw = std::atan2(Z(1, 0), Z(0, 0)) / ulc::kRadPerDeg;
     for (int k = -half; k <= half; ++k) {
       const Peak p = best_shift_near(in.grids[1], g.points, yaw + k * o.fine_step_deg, shift.x(),
                                      shift.y(), static_cast<int>(o.pose_shift_voxels),
@@ -422,7 +421,7 @@ inline GroundVoteResult ground_vote(const GroundVoteInput& in, const GroundVoteO
   double rival = 0.0;
   for (const auto& [p, share] : refined) {
     r.peaks.push_back(pose_of(in, p));
-    if (ulc::rotation_error_rad(r.peaks.back().rotation, r.rotation) / kRadPerDeg >
+    if (ulc::rotation_error_rad(r.peaks.back().rotation, r.rotation) / ulc::kRadPerDeg >
         o.margin_separation_deg)
       rival = std::max(rival, share);
   }

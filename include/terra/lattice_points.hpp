@@ -17,6 +17,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "ulc/core/angles.hpp"
 #include "ulc/core/kdtree.hpp"
 #include "ulc/core/types.hpp"
 
@@ -28,14 +29,13 @@ using LatticeIndex = std::uint32_t;
 inline std::vector<ulc::Vec3d> fibonacci_lattice(std::size_t n) {
   std::vector<ulc::Vec3d> points;
   if (n < 2) return points;
-  constexpr double kPi = 3.14159265358979323846;
   const double golden = (std::sqrt(5.0) + 1.0) / 2.0;
   points.reserve(n);
   for (std::size_t i = 0; i < n; ++i) {
     const double fi = static_cast<double>(i);
     const double y = 1.0 - 2.0 * fi / static_cast<double>(n - 1);
     const double radius = std::sqrt(std::fmax(0.0, 1.0 - y * y));
-    const double theta = 2.0 * kPi * fi / golden;
+    const double theta = 2.0 * ulc::kPi * fi / golden;
     points.emplace_back(radius * std::cos(theta), y, radius * std::sin(theta));
   }
   return points;
@@ -44,8 +44,7 @@ inline std::vector<ulc::Vec3d> fibonacci_lattice(std::size_t n) {
 /// The mean spacing of n points spread evenly on the unit sphere: the side of a square of
 /// area 4 pi / n, in radians. Used to size lookup tables and search grids.
 inline double lattice_spacing_rad(std::size_t n) {
-  constexpr double kPi = 3.14159265358979323846;
-  return n == 0 ? 0.0 : std::sqrt(4.0 * kPi / static_cast<double>(n));
+  return n == 0 ? 0.0 : std::sqrt(4.0 * ulc::kPi / static_cast<double>(n));
 }
 
 /// The reference answer: O(N) scan. For tests and table construction only.

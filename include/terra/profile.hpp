@@ -15,6 +15,7 @@
 #include "terra/lattice.hpp"
 #include "terra/random_rotation.hpp"
 #include "terra/search.hpp"
+#include "ulc/core/angles.hpp"
 #include "ulc/core/point_traits.hpp"
 #include "ulc/core/pose_error.hpp"
 #include "ulc/core/types.hpp"
@@ -43,8 +44,7 @@ ProfileCase profile_case(const Lattice& lattice, const BaseCloud& base, const Ta
   std::vector<ulc::Vec3<S>> turned(ulc::traits::size(target));
   for (std::size_t i = 0; i < turned.size(); ++i) turned[i] = Q * ulc::traits::point(target, i);
   out.result = estimate_rotation(lattice, base, turned, params);
-  constexpr double kDegPerRad = 180.0 / 3.14159265358979323846;
-  out.error_deg = ulc::rotation_error_rad(out.truth, out.result.rotation) * kDegPerRad;
+  out.error_deg = ulc::rotation_error_rad(out.truth, out.result.rotation) * ulc::kDegPerRad;
   return out;
 }
 

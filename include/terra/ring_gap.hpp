@@ -17,6 +17,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "ulc/core/angles.hpp"
 #include "ulc/core/point_traits.hpp"
 #include "ulc/core/types.hpp"
 
@@ -34,12 +35,11 @@ namespace ring_gap_detail {
 /// Points per elevation bin, from -90 deg.
 template <class Cloud>
 std::vector<std::size_t> elevation_histogram(const Cloud& frame, const RingGapOptions& o) {
-  const double rad_to_deg = 180.0 / 3.14159265358979323846;
   std::vector<std::size_t> bins(static_cast<std::size_t>(std::ceil(180.0 / o.bin_deg)) + 1, 0);
   for (std::size_t i = 0; i < ulc::traits::size(frame); ++i) {
     const ulc::Vec3d p = ulc::traits::point(frame, i).template cast<double>();
     if (!p.allFinite() || p.norm() < o.min_range) continue;
-    const double elevation = std::atan2(p.z(), std::hypot(p.x(), p.y())) * rad_to_deg;
+    const double elevation = std::atan2(p.z(), std::hypot(p.x(), p.y())) * ulc::kDegPerRad;
     const double k = std::floor((elevation + 90.0) / o.bin_deg);
     if (k >= 0.0 && k < double(bins.size())) ++bins[static_cast<std::size_t>(k)];
   }

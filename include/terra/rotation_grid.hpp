@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "terra/lattice_points.hpp"
+#include "ulc/core/angles.hpp"
 #include "ulc/core/lie.hpp"
 #include "ulc/core/types.hpp"
 
@@ -31,19 +32,20 @@ namespace terra {
 
 /// Rotations of the grid at `stride_rad` (0 < stride <= pi; otherwise empty).
 inline std::vector<ulc::Mat3d> so3_grid(double stride_rad) {
-  constexpr double kPi = 3.14159265358979323846;
   std::vector<ulc::Mat3d> grid;
-  if (!(stride_rad > 0.0 && stride_rad <= kPi)) return grid;
-  const auto directions =
-      static_cast<std::size_t>(std::max(2.0, std::round(4.0 * kPi / (stride_rad * stride_rad))));
-  const auto rolls = static_cast<std::size_t>(std::max(1.0, std::round(2.0 * kPi / stride_rad)));
+  if (!(stride_rad > 0.0 && stride_rad <= ulc::kPi)) return grid;
+  const auto directions = static_cast<std::size_t>(
+      std::max(2.0, std::round(4.0 * ulc::kPi / (stride_rad * stride_rad))));
+  const auto rolls =
+      static_cast<std::size_t>(std::max(1.0, std::round(2.0 * ulc::kPi / stride_rad)));
   grid.reserve(directions * rolls);
   for (const ulc::Vec3d& d : fibonacci_lattice(directions)) {
     // R e_x = (cos p cos y, cos p sin y, -sin p)
     const double yaw = std::atan2(d.y(), d.x());
     const double pitch = std::atan2(-d.z(), std::hypot(d.x(), d.y()));
     for (std::size_t k = 0; k < rolls; ++k) {
-      const double roll = -kPi + 2.0 * kPi * static_cast<double>(k) / static_cast<double>(rolls);
+      const double roll =
+          -ulc::kPi + 2.0 * ulc::kPi * static_cast<double>(k) / static_cast<double>(rolls);
       grid.push_back(ulc::rotation_from_rpy(roll, pitch, yaw));
     }
   }

@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "terra/plane_fit.hpp"
+#include "ulc/core/angles.hpp"
 #include "ulc/core/lie.hpp"
 #include "ulc/core/point_traits.hpp"
 #include "ulc/core/types.hpp"
@@ -64,7 +65,6 @@ inline ulc::Mat3d levelling_rotation(const ulc::Vec3d& n) {
 template <class Cloud>
 ScanContext make_scan_context(const Cloud& cloud, const PlaneFit& plane,
                               const ScanContextOptions& options) {
-  constexpr double kPi = 3.14159265358979323846;
   ScanContext sc;
   sc.rings = options.rings;
   sc.sectors = options.sectors;
@@ -76,8 +76,8 @@ ScanContext make_scan_context(const Cloud& cloud, const PlaneFit& plane,
     const double r = std::hypot(p.x(), p.y());
     if (!(r < options.max_range)) continue;
     const auto ring = static_cast<std::size_t>(r / options.max_range * double(sc.rings));
-    const double azimuth = std::atan2(p.y(), p.x()) + kPi;  // [0, 2 pi]
-    auto sector = static_cast<std::size_t>(azimuth / (2.0 * kPi) * double(sc.sectors));
+    const double azimuth = std::atan2(p.y(), p.x()) + ulc::kPi;  // [0, 2 pi]
+    auto sector = static_cast<std::size_t>(azimuth / (2.0 * ulc::kPi) * double(sc.sectors));
     if (sector >= sc.sectors) sector = 0;
     const double h = p.z() + plane.offset;  // height above the plane
     double& bin = sc.height[std::min(ring, sc.rings - 1) * sc.sectors + sector];
@@ -112,7 +112,6 @@ inline double scan_context_distance(const ScanContext& base, const ScanContext& 
 template <class BaseCloud, class TargetCloud>
 ScanContextResult scan_context_rotation(const BaseCloud& base, const TargetCloud& target,
                                         const ScanContextOptions& options = {}) {
-  constexpr double kPi = 3.14159265358979323846;
   ScanContextResult result;
   if (options.rings == 0 || options.sectors < 3 || !(options.max_range > 0)) {
     result.reason = "scan context needs rings >= 1, sectors >= 3 and max_range > 0";
@@ -144,7 +143,7 @@ ScanContextResult scan_context_rotation(const BaseCloud& base, const TargetCloud
   const double curvature = lo - 2.0 * d[best] + hi;
   if (std::isfinite(lo) && std::isfinite(hi) && curvature > 0)
     frac = std::max(-0.5, std::min(0.5, 0.5 * (lo - hi) / curvature));
-  result.yaw_rad = (static_cast<double>(best) + frac) * 2.0 * kPi / double(options.sectors);
+  result.yaw_rad = (static_cast<double>(best) + frac) * 2.0 * ulc::kPi / double(options.sectors);
   const ulc::Mat3d Rz = ulc::rotation_from_rpy(0.0, 0.0, result.yaw_rad);
   result.rotation = levelling_rotation(result.base_plane.normal).transpose() * Rz *
                     levelling_rotation(result.target_plane.normal);

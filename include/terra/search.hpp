@@ -38,14 +38,13 @@
 #include "terra/lattice.hpp"
 #include "terra/rotation_grid.hpp"
 #include "terra/search_params.hpp"
+#include "ulc/core/angles.hpp"
 #include "ulc/core/point_traits.hpp"
 #include "ulc/core/types.hpp"
 
 namespace terra {
 
 namespace search_detail {
-
-constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
 
 inline double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -179,7 +178,7 @@ SearchResult search_rotation(const Lattice& lattice, const Lookup& lookup,
   auto t0 = std::chrono::steady_clock::now();
   ulc::Mat3d R0 = ulc::Mat3d::Identity();
   {
-    std::vector<ulc::Mat3d> coarse = so3_grid(params.overlap_stride_deg * kDegToRad);
+    std::vector<ulc::Mat3d> coarse = so3_grid(params.overlap_stride_deg * ulc::kRadPerDeg);
     coarse.insert(coarse.begin(), ulc::Mat3d::Identity());
     for (const ulc::Mat3d& R : coarse) {
       ++stats.overlap.rotations;
@@ -195,7 +194,7 @@ SearchResult search_rotation(const Lattice& lattice, const Lookup& lookup,
 
   // Stage 1: the grid around R0, best top_k with overlap.
   t0 = std::chrono::steady_clock::now();
-  const std::vector<ulc::Mat3d> grid = so3_grid(params.coarse_stride_deg * kDegToRad);
+  const std::vector<ulc::Mat3d> grid = so3_grid(params.coarse_stride_deg * ulc::kRadPerDeg);
   std::vector<DistanceValue> values(grid.size());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, grid.size(), 16),
                     [&](const tbb::blocked_range<std::size_t>& r) {
@@ -240,7 +239,7 @@ SearchResult search_rotation(const Lattice& lattice, const Lookup& lookup,
 
   // Stage 2: descend from each seed.
   t0 = std::chrono::steady_clock::now();
-  const std::vector<ulc::Mat3d> moves = descent_moves(params.fine_stride_deg * kDegToRad);
+  const std::vector<ulc::Mat3d> moves = descent_moves(params.fine_stride_deg * ulc::kRadPerDeg);
   result.refined = result.seeds;
   std::vector<std::size_t> evaluations(result.seeds.size(), 0);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, result.seeds.size(), 1),

@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 #include <cmath>
 
+#include "ulc/core/angles.hpp"
 #include "ulc/core/lie.hpp"
 #include "ulc/core/types.hpp"
 
@@ -46,7 +47,6 @@ struct PoseError {
 /// Rotation and translation error of T against T_gt, computed in double.
 template <typename S>
 PoseError pose_error(const Isometry3<S>& T_gt, const Isometry3<S>& T) {
-  constexpr double kDegPerRad = 180.0 / 3.14159265358979323846;
   const Mat3d R_gt = T_gt.linear().template cast<double>();
   const Mat3d R = T.linear().template cast<double>();
   PoseError e;

@@ -17,6 +17,7 @@
 #include <utility>
 
 #include "pipeline/pair_calibration.hpp"
+#include "ulc/core/angles.hpp"
 #include "ulc/core/lie.hpp"
 #include "ulc/io/json_file.hpp"
 #include "ulc/io/result_file.hpp"
@@ -24,8 +25,6 @@
 namespace ulc::io {
 
 namespace result_detail {
-
-constexpr double kDegPerRad = 180.0 / 3.14159265358979323846;
 
 inline Json stage_stats(const terra::StageStats& s) {
   Json j = Json::object();
@@ -99,7 +98,7 @@ inline Json terra_to_json(const TerraReport& t) {
   j["status"] = terra::to_string(t.status);
   j["reason"] = t.reason;
   j["frame_index"] = t.frame_index;
-  j["rpy_deg"] = vector_to_json(rpy_from_rotation(t.rotation) * result_detail::kDegPerRad);
+  j["rpy_deg"] = vector_to_json(rpy_from_rotation(t.rotation) * kDegPerRad);
   j["distance"] = t.distance;
   j["mask_count"] = t.mask_count;
   j["base_points"] = t.base_points;
@@ -130,7 +129,7 @@ inline Json terra_to_json(const TerraReport& t) {
   for (const TerraHypothesis& h : t.hypotheses) {
     Json e = Json::object();
     e["source"] = h.motion ? std::string("motion") : std::string(to_string(h.source));
-    e["rpy_deg"] = vector_to_json(rpy_from_rotation(h.rotation) * result_detail::kDegPerRad);
+    e["rpy_deg"] = vector_to_json(rpy_from_rotation(h.rotation) * kDegPerRad);
     e["distance"] = h.distance;
     e["mask_count"] = h.mask_count;
     e["outcome"] = h.status == CalibrateStatus::ok
@@ -163,7 +162,7 @@ inline Json jeep_to_json(const JeepReport& r) {
   j["off_ground_overlap"] = r.off_ground_overlap;
   j["two_way"] = r.two_way;
   j["two_way_gap_m"] = r.two_way_gap_translation;
-  j["two_way_gap_deg"] = r.two_way_gap_rotation * result_detail::kDegPerRad;
+  j["two_way_gap_deg"] = r.two_way_gap_rotation * kDegPerRad;
   j["start_basins"] = r.start_basins;
   j["start_chosen"] = r.start_chosen;
   j["judged_by_hots"] = r.judged_by_hots;

@@ -25,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "ulc/core/angles.hpp"
 #include "ulc/core/lie.hpp"
 #include "ulc/core/observability_types.hpp"
 #include "ulc/io/json_file.hpp"
@@ -124,7 +125,6 @@ inline void observability_from_json(const Json& e, const std::string& file,
 }
 
 inline Json to_json(const PairResult& r) {
-  constexpr double kDeg = 180.0 / 3.14159265358979323846;
   Json e = Json::object();
   e["base"] = r.base;
   e["target"] = r.target;
@@ -135,7 +135,7 @@ inline Json to_json(const PairResult& r) {
   e["translation_m"] = vector_to_json(r.T_base_target.translation());
   const Eigen::Quaterniond q(r.T_base_target.linear());
   e["rotation_quat_wxyz"] = vector_to_json(Eigen::Vector4d(q.w(), q.x(), q.y(), q.z()));
-  e["rpy_deg"] = vector_to_json(ulc::rpy_from_rotation(r.T_base_target.linear()) * kDeg);
+  e["rpy_deg"] = vector_to_json(ulc::rpy_from_rotation(r.T_base_target.linear()) * kDegPerRad);
   e["time_offset_s"] = r.time_offset_s ? Json(*r.time_offset_s) : Json();
   e["covariance_6x6"] = r.covariance_6x6 ? matrix_to_json(*r.covariance_6x6) : Json();
   if (!r.clock.is_null()) e["clock"] = r.clock;

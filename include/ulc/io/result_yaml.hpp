@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "ulc/core/angles.hpp"
 #include "ulc/core/lie.hpp"
 #include "ulc/io/file_bytes.hpp"
 #include "ulc/io/io_error.hpp"
@@ -83,7 +84,6 @@ inline void unobservable(YAML::Emitter& y, const std::vector<ulc::UnobservableDi
 }
 
 inline void result(YAML::Emitter& y, const PairResult& r) {
-  constexpr double kDeg = 180.0 / 3.14159265358979323846;
   const Eigen::Isometry3d& T = r.T_base_target;
   const Eigen::Vector3d t = T.translation();
   const Eigen::Vector3d rpy = ulc::rpy_from_rotation(Eigen::Matrix3d(T.linear()));
@@ -107,7 +107,7 @@ inline void result(YAML::Emitter& y, const PairResult& r) {
   row(y, "translation_m", t);
   row(y, "rotation_quat_wxyz", Eigen::Vector4d(q.w(), q.x(), q.y(), q.z()));
   row(y, "rotation_quat_xyzw", Eigen::Vector4d(q.x(), q.y(), q.z(), q.w()));
-  row(y, "rpy_deg", Eigen::Vector3d(rpy * kDeg));
+  row(y, "rpy_deg", Eigen::Vector3d(rpy * kDegPerRad));
   row(y, "rpy_rad", rpy);
   quoted(y, "static_transform_publisher",
          num(t.x()) + " " + num(t.y()) + " " + num(t.z()) + " " + num(rpy.z()) + " " +

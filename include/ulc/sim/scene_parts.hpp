@@ -14,12 +14,11 @@
 #include <algorithm>
 #include <cmath>
 
+#include "ulc/core/angles.hpp"
 #include "ulc/sim/random.hpp"
 #include "ulc/sim/scene.hpp"
 
 namespace ulc::sim {
-
-constexpr double kPi = 3.14159265358979323846;
 
 inline double deg_to_rad(double d) {
   return d * kPi / 180.0;

@@ -25,6 +25,7 @@
 #include <variant>
 #include <vector>
 
+#include "ulc/core/angles.hpp"
 #include "ulc/core/types.hpp"
 #include "ulc/sim/random.hpp"
 
@@ -35,16 +36,16 @@ struct RangeModel {
   double min_range = 0.5;    ///< m; closer returns are discarded
   double max_range = 100.0;  ///< m, reached on a surface of reference_reflectivity
   double reference_reflectivity = 0.5;
-  double range_sigma = 0.02;        ///< m, 1 sigma Gaussian range noise
-  double range_resolution = 0.002;  ///< m, output quantisation
-  double angular_jitter = 0.05 * 3.14159265358979323846 / 180.0;  ///< rad, 1 sigma per axis
-  double base_dropout = 0.02;  ///< probability of losing any return
+  double range_sigma = 0.02;                   ///< m, 1 sigma Gaussian range noise
+  double range_resolution = 0.002;             ///< m, output quantisation
+  double angular_jitter = 0.05 * kPi / 180.0;  ///< rad, 1 sigma per axis
+  double base_dropout = 0.02;                  ///< probability of losing any return
 };
 
 /// Angular limits of a model's rays, for checks: azimuth and elevation ranges, or a cone of
 /// `cone_radius` around +x when cone_radius > 0.
 struct FieldOfView {
-  double azimuth_min = -3.14159265358979323846, azimuth_max = 3.14159265358979323846;
+  double azimuth_min = -kPi, azimuth_max = kPi;
   double elevation_min = -1.5707963267948966, elevation_max = 1.5707963267948966;
   double cone_radius = 0.0;
 
@@ -128,10 +129,10 @@ struct SpinningLidar {
     sin_el_.resize(lasers());
     offset_rad_.assign(lasers(), 0.0);
     for (std::size_t i = 0; i < lasers(); ++i) {
-      elevation_rad_[i] = elevation_deg[i] * kDegToRad;
+      elevation_rad_[i] = elevation_deg[i] * kRadPerDeg;
       cos_el_[i] = std::cos(elevation_rad_[i]);
       sin_el_[i] = std::sin(elevation_rad_[i]);
-      if (i < azimuth_offset_deg.size()) offset_rad_[i] = azimuth_offset_deg[i] * kDegToRad;
+      if (i < azimuth_offset_deg.size()) offset_rad_[i] = azimuth_offset_deg[i] * kRadPerDeg;
     }
   }
 
@@ -167,14 +168,12 @@ struct SpinningLidar {
 
   FieldOfView fov() const {
     FieldOfView v;
-    v.elevation_min = *std::min_element(elevation_deg.begin(), elevation_deg.end()) * kDegToRad;
-    v.elevation_max = *std::max_element(elevation_deg.begin(), elevation_deg.end()) * kDegToRad;
+    v.elevation_min = *std::min_element(elevation_deg.begin(), elevation_deg.end()) * kRadPerDeg;
+    v.elevation_max = *std::max_element(elevation_deg.begin(), elevation_deg.end()) * kRadPerDeg;
     return v;
   }
 
-  static constexpr double kPi = 3.14159265358979323846;
   static constexpr double kTwoPi = 2.0 * kPi;
-  static constexpr double kDegToRad = kPi / 180.0;
 
  private:
   std::vector<int> order_;
@@ -226,9 +225,8 @@ struct RisleyLidar {
       re += prisms[k].amplitude_deg * std::cos(angle);
       im += prisms[k].amplitude_deg * std::sin(angle);
     }
-    constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
-    r.azimuth = (scale_az * re + ch.azimuth_deg) * kDegToRad;
-    r.elevation = (scale_el * im + ch.elevation_deg) * kDegToRad;
+    r.azimuth = (scale_az * re + ch.azimuth_deg) * kRadPerDeg;
+    r.elevation = (scale_el * im + ch.elevation_deg) * kRadPerDeg;
     r.dir = direction_of(r.azimuth, r.elevation);
     return r;
   }
@@ -240,11 +238,10 @@ struct RisleyLidar {
   }
 
   FieldOfView fov() const {
-    constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
     FieldOfView v;
     const double a = amplitude_sum();
     if (circular) {
-      v.cone_radius = a * scale_az * kDegToRad;
+      v.cone_radius = a * scale_az * kRadPerDeg;
       return v;
     }
     double az_lo = 0, az_hi = 0, el_lo = 0, el_hi = 0;
@@ -254,10 +251,10 @@ struct RisleyLidar {
       el_lo = std::min(el_lo, ch.elevation_deg);
       el_hi = std::max(el_hi, ch.elevation_deg);
     }
-    v.azimuth_min = (az_lo - scale_az * a) * kDegToRad;
-    v.azimuth_max = (az_hi + scale_az * a) * kDegToRad;
-    v.elevation_min = (el_lo - scale_el * a) * kDegToRad;
-    v.elevation_max = (el_hi + scale_el * a) * kDegToRad;
+    v.azimuth_min = (az_lo - scale_az * a) * kRadPerDeg;
+    v.azimuth_max = (az_hi + scale_az * a) * kRadPerDeg;
+    v.elevation_min = (el_lo - scale_el * a) * kRadPerDeg;
+    v.elevation_max = (el_hi + scale_el * a) * kRadPerDeg;
     return v;
   }
 
@@ -282,25 +279,23 @@ struct MemsLidar {
   }
 
   SensorRay ray(std::size_t i, const FrameSetup& f) const {
-    constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
     const std::size_t lasers = zone_center_deg.size();
     const std::size_t sample = i / lasers * f.decimation;
     SensorRay r;
     r.time = static_cast<double>(sample) / laser_rate_hz;
     const double fast = std::sin(6.283185307179586 * fast_axis_hz * (f.start_time + r.time));
-    r.azimuth = (zone_center_deg[i % lasers] + zone_half_width_deg * fast) * kDegToRad;
-    r.elevation = elevation_half_deg * (1.0 - 2.0 * r.time * f.rate_hz) * kDegToRad;
+    r.azimuth = (zone_center_deg[i % lasers] + zone_half_width_deg * fast) * kRadPerDeg;
+    r.elevation = elevation_half_deg * (1.0 - 2.0 * r.time * f.rate_hz) * kRadPerDeg;
     r.dir = direction_of(r.azimuth, r.elevation);
     return r;
   }
 
   FieldOfView fov() const {
-    constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
     FieldOfView v;
-    v.azimuth_min = (zone_center_deg.front() - zone_half_width_deg) * kDegToRad;
-    v.azimuth_max = (zone_center_deg.back() + zone_half_width_deg) * kDegToRad;
-    v.elevation_min = -elevation_half_deg * kDegToRad;
-    v.elevation_max = elevation_half_deg * kDegToRad;
+    v.azimuth_min = (zone_center_deg.front() - zone_half_width_deg) * kRadPerDeg;
+    v.azimuth_max = (zone_center_deg.back() + zone_half_width_deg) * kRadPerDeg;
+    v.elevation_min = -elevation_half_deg * kRadPerDeg;
+    v.elevation_max = elevation_half_deg * kRadPerDeg;
     return v;
   }
 };

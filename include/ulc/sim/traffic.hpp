@@ -16,6 +16,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "ulc/core/angles.hpp"
 #include "ulc/sim/ground.hpp"
 #include "ulc/sim/path.hpp"
 #include "ulc/sim/primitives.hpp"
@@ -78,8 +79,7 @@ class Traffic {
       const Vec3d cb(pb.position.x(), pb.position.y(),
                      ground_.height(pb.position.x(), pb.position.y()));
       // Driving backwards along the lane: the car faces against the lane's heading.
-      const Mat3d R =
-          Eigen::AngleAxisd(pm.heading + 3.14159265358979323846, Vec3d::UnitZ()).toRotationMatrix();
+      const Mat3d R = Eigen::AngleAxisd(pm.heading + kPi, Vec3d::UnitZ()).toRotationMatrix();
       const Vec3d velocity = (cb - ca) / (t1 - t0);
       const double l = car.length, w = car.width;
       add(out, ca + R * Vec3d(0.0, 0.0, 0.6), R, Vec3d(l / 2, w / 2, 0.35), car.paint, velocity);
