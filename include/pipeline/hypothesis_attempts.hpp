@@ -5,16 +5,16 @@
 //     points at its rotation (JEEP failed, or HOTS's cross links disagree) and HOTS can judge
 //     the next; the first success wins (HypothesisOptions::count, fallback).
 //   - A static snapshot (fewer than StageTuning::hots_min_frames frames, the free-space check
-//     judging JEEP's answer, free_space.hpp): no HOTS can judge an answer, so only an accepted
-//     one opens a contest. When the first hypothesis's answer passed JEEP's acceptance and the
-//     free-space check, the next HypothesisOptions::snapshot_rivals hypotheses run too, and of
-//     the answers that passed both the one whose target sees most of the base's scene off the
-//     ground (JEEP's off_ground_overlap) wins; ties keep the better-ranked hypothesis. A few
-//     frames of a moving rig hold one as well when their first pair was taken together (the
-//     check judges it only then). A
-//     look-alike of the street (its forward/backward twin) overlaps the base's walls and poles less
-//     than the mount does. A snapshot whose first answer failed tries no other: a later hypothesis
-//     accepted alone was wrong more often than right (docs/experiments/free_space_check.md).
+//     judging JEEP's answer, free_space.hpp): no HOTS can judge an answer, so only an accepted one
+//     opens a contest. When the first hypothesis's answer passed JEEP's acceptance and the
+//     free-space check, the next HypothesisOptions::snapshot_rivals hypotheses run too, and of the
+//     answers that passed both the one whose target sees most of the base's scene off the ground
+//     (JEEP's off_ground_overlap) wins; ties keep the better-ranked hypothesis. A few frames of a
+//     moving rig hold one as well when their first pair was taken together (the check judges it
+//     only then). A look-alike of the street (its forward/backward twin) overlaps the base's walls
+//     and poles less than the mount does. A snapshot whose first answer failed tries no other: a
+//     later hypothesis accepted alone was wrong more often than right
+//     (docs/experiments/free_space_check.md).
 //
 // Nothing here throws; deterministic (each attempt is; the choice is ordered comparisons).
 #pragma once

@@ -29,9 +29,10 @@ struct HypothesisOptions {
   /// docs/experiments/terra_hypotheses.md), while the cross links separate right from wrong.
   /// false: any JEEP failure ends the attempt.
   bool hots_judges_jeep = true;
-  /// A static snapshot (no HOTS to judge): when the first hypothesis's answer is accepted (JEEP's
-  /// acceptance and the free-space check), up to this many next hypotheses run too and the
-  /// accepted answer seeing most of the scene off the ground wins (hypothesis_attempts.hpp).
+  /// A static snapshot (no HOTS to judge): when the first hypothesis's answer is accepted by JEEP
+  /// and judged and passed by the free-space check, up to this many next hypotheses run too and
+  /// of the answers passing both the one seeing most of the scene off the ground wins
+  /// (hypothesis_attempts.hpp).
   /// Over the parked census (bench_covariance --parked, seeds 1-20) it turned no right answer
   /// wrong and mended flicar-lift seed 17's two twins (docs/experiments/free_space_check.md);
   /// it costs one JEEP on one frame pair per rival. 0 = the first accepted answer stands.

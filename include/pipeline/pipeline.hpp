@@ -36,8 +36,8 @@
 //     clock offset the drive does not pin down fails too (time_offset_untrusted: the extrinsic
 //     would carry the offset's error times the speed); a caller who knows the clocks' offset sets
 //     time_offset_s, and then no offset is estimated or checked.
-//   - TERRA's hypotheses and HOTS as the judge (not in the paper): with HOTS on a moving rig,
-//     a JEEP that was rejected or did not settle hands its extrinsic to HOTS
+//   - TERRA's hypotheses and HOTS as the judge (not in the paper): with HOTS on a moving rig, a
+//     JEEP that was rejected or did not settle hands its extrinsic to HOTS
 //     (tuning.hypotheses.hots_judges_jeep), and when the attempt from TERRA's best rotation fails
 //     in a way that points at the rotation (JEEP failed, or HOTS's extrinsic_unconfirmed), TERRA's
 //     next distinct optima run in turn (up to tuning.hypotheses.count); the first success wins.
@@ -45,10 +45,9 @@
 //     optima, then those of the search not kept) run, each needing JEEP's own acceptance before
 //     HOTS. With none, the best one's failure is reported. On a static snapshot an accepted first
 //     answer meets its rivals instead (tuning.hypotheses.snapshot_rivals; hypothesis_attempts.hpp).
-//     stages.terra.hypotheses lists each one
-//     tried and its outcome; timings sum over all of them. Each starts from its rotation and
-//     translation 0, or from the ground vote's lever arm when it lies within vote_agree_deg of
-//     a confident vote's rotation (StartRotations::start).
+//     stages.terra.hypotheses lists each one tried and its outcome; timings sum over all of them.
+//     Each starts from its rotation and translation 0, or from the ground vote's lever arm when it
+//     lies within vote_agree_deg of a confident vote's rotation (StartRotations::start).
 //   - Degenerate verdict (observability_verdict.hpp): when the call ends, the final problem's
 //     information for the extrinsic (HOTS's whole-sequence step, else JEEP's final
 //     registration) is judged; a direction it leaves free makes the status degenerate, over
