@@ -74,22 +74,25 @@ inline void take_stages(PairCalibration& r, const PairCalibration& attempt) {
   r.covariance_6x6 = attempt.covariance_6x6;
 }
 
-/// One hypothesis's attempt and how it ended, listed in stages.terra.hypotheses.
-struct HypothesisRun {
-  PairCalibration attempt;
-  StageOutcome outcome;
-};
-
 /// What a snapshot's contest compares: JEEP's off-ground overlap of an answer that JEEP
 /// accepted and the free-space check judged and passed (at least FreeSpaceOptions::min_points
 /// judged: the contest is held only where the base's rays vouch for the answers), -inf for any
 /// other.
-inline double contest_score(const HypothesisRun& run, const FreeSpaceOptions& free_space) {
-  const auto& j = run.attempt.jeep;
-  const bool vouched = run.outcome.status == CalibrateStatus::ok && j && j->accepted &&
-                       j->free_space && j->free_space->judged >= free_space.min_points;
+inline double contest_score(const PairCalibration& attempt, const StageOutcome& outcome,
+                            const FreeSpaceOptions& free_space) {
+  const auto& j = attempt.jeep;
+  const bool vouched = outcome.status == CalibrateStatus::ok && j && j->accepted && j->free_space &&
+                       j->free_space->judged >= free_space.min_points;
   return vouched ? j->off_ground_overlap : -std::numeric_limits<double>::infinity();
 }
+
+/// One hypothesis's attempt, how it ended (listed in stages.terra.hypotheses) and its score in
+/// a snapshot's contest.
+struct HypothesisRun {
+  PairCalibration attempt;
+  StageOutcome outcome;
+  double contest_score = -std::numeric_limits<double>::infinity();
+};
 
 /// The stages from hypothesis k, its entry in r.terra->hypotheses and its timings in r's.
 template <class FA, class FB>
@@ -105,8 +108,8 @@ HypothesisRun run_hypothesis(const AttemptInputs<FA, FB>& in, const StartRotatio
   entry.status = run.outcome.status;
   entry.reason = run.outcome.reason;
   entry.seconds = seconds_since(t0);
-  if (const double score = contest_score(run, in.options.tuning.free_space); std::isfinite(score))
-    entry.off_ground_overlap = score;
+  run.contest_score = contest_score(run.attempt, run.outcome, in.options.tuning.free_space);
+  if (std::isfinite(run.contest_score)) entry.off_ground_overlap = run.contest_score;
   r.terra->hypotheses.push_back(entry);
   add_timings(r.timing_s, run.attempt.timing_s);
   return run;
@@ -123,8 +126,7 @@ PairCalibration snapshot_contest(const AttemptInputs<FA, FB>& in, const StartRot
   std::size_t best_k = 0;
   for (std::size_t k = 1; k < end; ++k) {
     HypothesisRun rival = run_hypothesis(in, starts, k, r);
-    const FreeSpaceOptions& free_space = in.options.tuning.free_space;
-    if (contest_score(rival, free_space) <= contest_score(best, free_space)) continue;
+    if (rival.contest_score <= best.contest_score) continue;
     best = std::move(rival);
     best_k = k;
   }
@@ -139,7 +141,7 @@ template <class FA, class FB>
 bool opens_contest(const AttemptInputs<FA, FB>& in, const HypothesisRun& first) {
   const bool snapshot = in.frames_left() < in.options.tuning.hots_min_frames;
   return snapshot && in.options.tuning.hypotheses.snapshot_rivals > 0 &&
-         std::isfinite(contest_score(first, in.options.tuning.free_space));
+         std::isfinite(first.contest_score);
 }
 
 /// TERRA's hypotheses in turn (see the top of this file): when what followed one points at its
