@@ -119,6 +119,70 @@ inline void extract_cell(const std::vector<WindowPoint>& points, std::vector<std
 
 constexpr std::size_t kVoxelGrain = 16;
 
+/// The window's usable points (finite, with a voxel) in frame order, each with its root voxel.
+struct WindowPoints {
+  std::vector<WindowPoint> points;
+  std::vector<ulc::VoxelKey> keys;  ///< keys[i]: the root voxel of points[i]
+};
+
+template <class Cloud>
+WindowPoints place_points(const std::vector<const Cloud*>& frames,
+                          const std::vector<Isometry3d>& poses, const PlaneExtractionOptions& o) {
+  std::size_t total = 0;
+  for (const Cloud* frame : frames)
+    if (frame) total += ulc::traits::size(*frame);
+  WindowPoints window;
+  window.points.reserve(total);
+  window.keys.reserve(total);
+  for (std::size_t f = 0; f < frames.size(); ++f) {
+    if (!frames[f]) continue;
+    const Cloud& cloud = *frames[f];
+    const std::size_t n = ulc::traits::size(cloud);
+    for (std::size_t i = 0; i < n; ++i) {
+      const Vec3d body = ulc::traits::point(cloud, i).template cast<double>();
+      if (!body.allFinite()) continue;
+      const Vec3d world = poses[f] * body;
+      const auto key = ulc::make_voxel_key(world, o.voxel_size);
+      if (!key) continue;
+      window.points.push_back({world, body, static_cast<std::uint32_t>(f)});
+      window.keys.push_back(*key);
+    }
+  }
+  return window;
+}
+
+/// Root voxels in order of their first point; voxel v holds the points
+/// members[start[v] .. start[v + 1]), ascending (a counting sort: no list per voxel).
+struct RootVoxels {
+  std::vector<ulc::VoxelKey> keys;
+  std::vector<std::uint32_t> start;
+  std::vector<std::uint32_t> members;
+};
+
+inline RootVoxels group_by_voxel(const WindowPoints& window) {
+  const std::size_t n = window.points.size();
+  ulc::VoxelMap<std::uint32_t> counts;  // key -> points in it
+  counts.reserve(n / 4 + 16);
+  std::vector<std::uint32_t> voxel_of(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t position = counts.try_emplace(window.keys[i], 0u).first;
+    ++counts.at_position(position).value;
+    voxel_of[i] = static_cast<std::uint32_t>(position);
+  }
+  RootVoxels roots;
+  roots.keys.reserve(counts.size());
+  roots.start.assign(counts.size() + 1, 0);
+  for (std::size_t v = 0; v < counts.size(); ++v) {
+    roots.keys.push_back(counts.at_position(v).key);
+    roots.start[v + 1] = roots.start[v] + counts.at_position(v).value;
+  }
+  std::vector<std::uint32_t> next(roots.start.begin(), roots.start.end() - 1);
+  roots.members.resize(n);
+  for (std::size_t i = 0; i < n; ++i)
+    roots.members[next[voxel_of[i]]++] = static_cast<std::uint32_t>(i);
+  return roots;
+}
+
 }  // namespace plane_detail
 
 inline bool valid_plane_extraction_options(const PlaneExtractionOptions& o) {
@@ -134,33 +198,20 @@ std::vector<Plane> extract_planes(const std::vector<const Cloud*>& frames,
                                   const PlaneExtractionOptions& options) {
   std::vector<Plane> planes;
   if (frames.size() != poses.size() || !valid_plane_extraction_options(options)) return planes;
-  std::vector<plane_detail::WindowPoint> points;
-  ulc::VoxelMap<std::vector<std::uint32_t>> voxels;
-  for (std::size_t f = 0; f < frames.size(); ++f) {
-    if (!frames[f]) continue;
-    const Cloud& cloud = *frames[f];
-    const std::size_t n = ulc::traits::size(cloud);
-    for (std::size_t i = 0; i < n; ++i) {
-      const Vec3d body = ulc::traits::point(cloud, i).template cast<double>();
-      if (!body.allFinite()) continue;
-      const Vec3d world = poses[f] * body;
-      const auto key = ulc::make_voxel_key(world, options.voxel_size);
-      if (!key) continue;
-      voxels[*key].push_back(static_cast<std::uint32_t>(points.size()));
-      points.push_back({world, body, static_cast<std::uint32_t>(f)});
-    }
-  }
-  std::vector<std::vector<Plane>> per_voxel(voxels.size());
+  const plane_detail::WindowPoints window = plane_detail::place_points(frames, poses, options);
+  const plane_detail::RootVoxels roots = plane_detail::group_by_voxel(window);
+  const std::size_t n_voxels = roots.keys.size();
+  std::vector<std::vector<Plane>> per_voxel(n_voxels);
   const double half = options.voxel_size / 2;
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, voxels.size(), plane_detail::kVoxelGrain),
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n_voxels, plane_detail::kVoxelGrain),
                     [&](const tbb::blocked_range<std::size_t>& r) {
                       for (std::size_t v = r.begin(); v != r.end(); ++v) {
-                        const auto& entry = voxels.at_position(v);
-                        std::vector<std::uint32_t> cell = entry.value;
-                        const Vec3d centre = ulc::voxel_corner(entry.key, options.voxel_size) +
+                        std::vector<std::uint32_t> cell(roots.members.begin() + roots.start[v],
+                                                        roots.members.begin() + roots.start[v + 1]);
+                        const Vec3d centre = ulc::voxel_corner(roots.keys[v], options.voxel_size) +
                                              Vec3d::Constant(half);
-                        plane_detail::extract_cell(points, cell, centre, half, 0, frames.size(),
-                                                   options, per_voxel[v]);
+                        plane_detail::extract_cell(window.points, cell, centre, half, 0,
+                                                   frames.size(), options, per_voxel[v]);
                       }
                     });
   for (auto& list : per_voxel)
