@@ -45,7 +45,7 @@ void print_usage(std::FILE* to) {
 /// come back as fresh pages: about a million page faults on the 60 s 64-32 drive, 9 s of system
 /// time. Keeping up to 256 MiB of freed memory and serving buffers below 32 MiB (glibc's
 /// largest threshold) from the heap halves them with the same peak memory
-/// (docs/BENCHMARKS.md, "Long drives"). Other allocators ignore this.
+/// (docs/experiments/sixty_second_drive_speed.md). Other allocators ignore this.
 void keep_freed_memory() {
 #if defined(__GLIBC__)
   mallopt(M_MMAP_THRESHOLD, 32 << 20);
