@@ -216,7 +216,10 @@ template <typename S>
 std::vector<ulc::Vec3<S>> merged_submap(const WindowEntries<S>& e, const Isometry3d& first_pose,
                                         double voxel) {
   const Isometry3d first_inv = first_pose.inverse();
+  std::size_t total = 0;
+  for (const auto& span : e.spans) total += span.size();
   std::vector<ulc::Vec3<S>> merged;
+  merged.reserve(total);
   for (std::size_t k = 0; k < e.spans.size(); ++k) {
     const Isometry3d T = first_inv * e.poses[k];
     for (const auto& p : e.spans[k])

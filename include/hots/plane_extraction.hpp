@@ -64,7 +64,10 @@ inline void extract_cell(const std::vector<WindowPoint>& points, std::vector<std
   }
   if (frames_seen < o.min_frames) return;
   const Mat3d M = placed.scatter();
-  const Eigen::SelfAdjointEigenSolver<Mat3d> solver(M);
+  // Closed form, as for the normals (ulc/core/normals.hpp): the planarity test and the
+  // normal need l0 apart from l1, where it is accurate.
+  Eigen::SelfAdjointEigenSolver<Mat3d> solver;
+  solver.computeDirect(M);
   const Vec3d lambda = solver.eigenvalues();
   bool planar = lambda(1) > 0.0 && lambda(0) <= o.max_eigen_ratio * lambda(1);
   if (planar) {
