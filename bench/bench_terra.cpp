@@ -620,7 +620,9 @@ struct MapsOptions {
   std::size_t below_mask = ulc::CalibrateOptions().tuning.terra_source.maps_below_mask;
   std::vector<ulc::TerraSource> sources = {ulc::TerraSource::frames, ulc::TerraSource::maps,
                                            ulc::TerraSource::automatic};
-  bool motion = true;         ///< the motion frame on (MapTerraOptions::motion)
+  bool motion = true;  ///< the motion frame on (MapTerraOptions::motion)
+  std::size_t vote_frames = ulc::MotionFrameOptions().vote_frames;  ///< frames the vote uses
+  std::size_t unsure_vote_frames = ulc::MotionFrameOptions().unsure_vote_frames;
   bool scan_context = false;  ///< a scancontext* row on each window's first frames
 };
 
@@ -744,6 +746,8 @@ ulc::PairCalibration terra_on_window(const Window& w, ulc::TerraSource source,
   co.tuning.terra_source.source = source;
   co.tuning.terra_source.maps.window_s = mo.window_s;
   co.tuning.terra_source.maps.motion.enabled = mo.motion;
+  co.tuning.terra_source.maps.motion.vote_frames = mo.vote_frames;
+  co.tuning.terra_source.maps.motion.unsure_vote_frames = mo.unsure_vote_frames;
   co.tuning.terra_source.maps_below_mask = mo.below_mask;
   return in_arena(mo.threads, [&] {
     return ulc::calibrate_pair(w.base, w.base_times, w.target, w.target_times, co);
@@ -758,8 +762,13 @@ void log_window(const std::string& name, std::size_t k, const char* label, doubl
             << (t ? std::string(ulc::to_string(t->source)) : std::string("-")) << ", motion "
             << (t && t->motion
                     ? (t->motion->ok ? (t->motion->used ? "used" : "agrees") : t->motion->reason)
-                    : std::string("-"))
-            << ", " << fmt(r.timing_s.terra, 2) << " s\n";
+                    : std::string("-"));
+  if (t && t->motion && t->motion->ok) std::cerr << " (" << t->motion->method << ")";
+  if (t && t->motion && t->motion->vote_ran)
+    std::cerr << ", vote " << t->motion->votes_confident << "/" << t->motion->votes
+              << " sure, score " << fmt(t->motion->vote.score, 2) << ", margin "
+              << fmt(t->motion->vote.margin, 2) << ", voxels " << t->motion->vote.points;
+  std::cerr << ", " << fmt(r.timing_s.terra, 2) << " s\n";
 }
 
 SourceTally run_source(const std::string& name, const std::vector<Window>& windows,
@@ -881,6 +890,14 @@ int main(int argc, char** argv) {
                "automatic and scancontext*");
   app.add_flag_callback(
       "--no-motion", [&] { mo.motion = false; }, "--maps/--windows: the motion frame off");
+  app.add_option("--vote-frames", mo.vote_frames,
+                 "--maps/--windows: target frames the ground vote uses (default 3)")
+      ->type_name("N")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--unsure-vote-frames", mo.unsure_vote_frames,
+                 "--maps/--windows: frames the vote uses where the first leave it unsure "
+                 "(default 5; 0: none)")
+      ->type_name("N");
   app.add_option("--starts", mo.starts, "--maps: windows per pair (default 8)")
       ->type_name("N")
       ->check(CLI::PositiveNumber);

@@ -35,6 +35,7 @@
 #include <cstddef>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "odometry/frame_pairing.hpp"
@@ -214,8 +215,67 @@ inline void stand_in_unsure_vote(const WindowAnswer& answer, double min_score, M
   m.method = "unsure ground vote";
 }
 
+namespace map_terra_detail {
+
+/// What the ground vote reads of a map window: the base's map and both LiDARs' frames from
+/// window frame `first` on.
+template <typename SA, class FramesA, class FramesB>
+struct VoteWindow {
+  const LocalMap<SA>& base_map;
+  const FramesA& frames_a;
+  const std::vector<double>& times_a;
+  const FramesB& frames_b;
+  const std::vector<double>& times_b;
+  std::size_t first = 0;
+};
+
+/// Some window frames' votes and what each voted on, in frame order.
+struct FrameVotes {
+  std::vector<std::size_t> frames;
+  std::vector<terra::GroundVoteInput> inputs;
+  std::vector<terra::GroundVoteResult> votes;
+};
+
+/// The votes of window frames `indices` (ascending), each against the base's map at the base
+/// frame nearest it in time; a frame `before` already voted keeps its vote.
+template <class Window>
+FrameVotes vote_frames(const Window& w, const std::vector<std::size_t>& indices, bool free_space,
+                       const terra::GroundVoteOptions& o, FrameVotes before = {}) {
+  FrameVotes out;
+  for (const std::size_t k : indices) {
+    const auto it = std::find(before.frames.begin(), before.frames.end(), k);
+    out.frames.push_back(k);
+    if (it != before.frames.end()) {
+      const auto i = static_cast<std::size_t>(it - before.frames.begin());
+      out.inputs.push_back(std::move(before.inputs[i]));
+      out.votes.push_back(std::move(before.votes[i]));
+      continue;
+    }
+    const std::size_t j =
+        nearest_time(w.times_a, w.times_b[w.first + k], w.first, w.base_map.poses.size());
+    out.inputs.push_back(
+        terra::prepare_ground_vote(map_at_frame(w.base_map, j), w.frames_b[w.first + k], o));
+    out.votes.push_back(terra::ground_vote(out.inputs.back(), o));
+    if (free_space) terra::add_free_space(out.inputs.back(), w.frames_a[w.first + j], o);
+  }
+  return out;
+}
+
+/// The window's answer from its frames' votes: their tally, with their pool beside it when
+/// pool_votes (window_vote.hpp).
+inline WindowAnswer answer_votes(const FrameVotes& fv, const MotionFrameOptions& o,
+                                 const terra::GroundVoteOptions& vote_options) {
+  const VoteTally tally = tally_votes(fv.votes, o.vote_agree_deg, o.vote.margin_separation_deg);
+  if (!o.pool_votes) return {fv.votes[tally.chosen], tally, false};
+  const PooledVote pool = pool_votes(fv.inputs, fv.votes, vote_options);
+  return window_answer(fv.votes, tally, pool, o.vote.margin_separation_deg);
+}
+
+}  // namespace map_terra_detail
+
 /// The ground vote of a few target window frames against the base's map (window_vote.hpp),
-/// pooled (MotionFrameOptions::pool_votes) or tallied, into the motion report.
+/// pooled (MotionFrameOptions::pool_votes) or tallied, into the motion report; more frames
+/// vote where none of the first was sure (MotionFrameOptions::unsure_vote_frames).
 template <typename SA, class FramesA, class FramesB>
 void add_ground_vote(const LocalMap<SA>& base_map, const FramesA& frames_a,
                      const std::vector<double>& times_a, const FramesB& frames_b,
@@ -225,25 +285,18 @@ void add_ground_vote(const LocalMap<SA>& base_map, const FramesA& frames_a,
   using namespace map_terra_detail;
   terra::GroundVoteOptions vote_options = o.vote;
   if (o.fill_base_rings) vote_options.base_ring_gap_deg = base_ring_gap_deg;
-  const std::vector<std::size_t> voted = vote_frame_indices(target_frames, o.vote_frames, anchor);
-  if (voted.empty()) return;  // an empty window: nothing to vote on
-  std::vector<terra::GroundVoteInput> inputs;
-  std::vector<terra::GroundVoteResult> votes;
-  for (const std::size_t k : voted) {
-    const std::size_t j = nearest_time(times_a, times_b[first + k], first, base_map.poses.size());
-    inputs.push_back(
-        terra::prepare_ground_vote(map_at_frame(base_map, j), frames_b[first + k], vote_options));
-    votes.push_back(terra::ground_vote(inputs.back(), vote_options));
-    if (o.pool_votes) terra::add_free_space(inputs.back(), frames_a[first + j], vote_options);
+  const VoteWindow<SA, FramesA, FramesB> window{base_map, frames_a, times_a,
+                                                frames_b, times_b,  first};
+  FrameVotes fv = vote_frames(window, vote_frame_indices(target_frames, o.vote_frames, anchor),
+                              o.pool_votes, vote_options);
+  if (fv.frames.empty()) return;  // an empty window: nothing to vote on
+  WindowAnswer answer = answer_votes(fv, o, vote_options);
+  if (answer.tally.confident == 0 && o.unsure_vote_frames > fv.frames.size()) {
+    const auto more = vote_frame_indices(target_frames, o.unsure_vote_frames, anchor);
+    fv = vote_frames(window, more, o.pool_votes, vote_options, std::move(fv));
+    answer = answer_votes(fv, o, vote_options);
   }
-  const VoteTally tally = tally_votes(votes, o.vote_agree_deg, o.vote.margin_separation_deg);
-  if (!o.pool_votes) {
-    report_vote(votes[tally.chosen], tally, voted[tally.chosen], voted.size(), m);
-    return;
-  }
-  const PooledVote pool = pool_votes(inputs, votes, vote_options);
-  const WindowAnswer answer = window_answer(votes, tally, pool, o.vote.margin_separation_deg);
-  report_vote(answer.vote, answer.tally, voted[answer.tally.chosen], voted.size(), m);
+  report_vote(answer.vote, answer.tally, fv.frames[answer.tally.chosen], fv.frames.size(), m);
   m.vote_pooled = answer.pooled;
   if (o.unsure_vote) stand_in_unsure_vote(answer, vote_options.min_score, m);
 }

@@ -285,7 +285,9 @@ TEST_CASE("the ground vote gives the 64-tele rotation from Tele frames, no targe
     REQUIRE(m.vote_ran);
     INFO("window " << k << ": " << m.reason << "; chosen vote " << m.vote.reason << ", margin "
                    << m.vote.margin << ", score " << m.vote.score);
-    CHECK(m.votes == 3);
+    // Three frames vote; five where none of the three was sure (unsure_vote_frames).
+    CHECK((m.votes == 3 || m.votes == 5));
+    if (m.votes_confident == 0) CHECK(m.votes == 5);
     CHECK(m.votes_agreeing <= m.votes_confident);
     // With the ground and travel refused, only a vote answers: sure, or the unsure pool's guess.
     CHECK(m.ok == (m.method == "ground vote" || m.method == "unsure ground vote"));
@@ -334,5 +336,49 @@ TEST_CASE("an unsure pooled vote stands in only where the ground and travel was 
     ulc::stand_in_unsure_vote(unsure, 0.1, travel);
     CHECK(travel.method == "ground and travel");
     CHECK(travel.rotation == ulc::Mat3d::Identity());
+  }
+}
+
+TEST_CASE("where none of the first three frames is sure, five vote, as if voted from the start",
+          "[calibrate][map_terra][ground_vote]") {
+  const auto& d = drive_64_tele();
+  const auto& a = d.lidars[0];
+  const auto& b = d.lidars[1];
+  terra::SplitMix64 rng(12);
+  const auto turned = turned_tele(d, rng).frames;
+  ulc::MapTerraOptions o;
+  o.window_s = 2.0;
+  o.motion.max_travel_mismatch = 0.0;  // the ground and travel refuse: the vote alone answers
+  const auto motion = [&](const ulc::MapTerraOptions& options) {
+    return ulc::build_local_maps(a.frames, a.timestamps, turned, b.timestamps, start_index(d),
+                                 options)
+        .motion;
+  };
+  SECTION("a sure frame among the first three: no second round") {
+    const ulc::MotionReport m = motion(o);
+    REQUIRE(m.vote_ran);
+    REQUIRE(m.votes_confident >= 1);
+    CHECK(m.votes == 3);
+  }
+  SECTION("none sure: five frames, the same answer as five from the start") {
+    o.motion.vote.min_score = 2.0;  // more than every vote landing: none is sure
+    const ulc::MotionReport twice = motion(o);
+    REQUIRE(twice.vote_ran);
+    CHECK(twice.votes == 5);
+    CHECK(twice.votes_confident == 0);
+    ulc::MapTerraOptions at_once = o;
+    at_once.motion.vote_frames = 5;
+    at_once.motion.unsure_vote_frames = 0;
+    const ulc::MotionReport once = motion(at_once);
+    CHECK(once.votes == 5);
+    CHECK(twice.ok == once.ok);
+    CHECK(twice.method == once.method);
+    CHECK(twice.vote_frame == once.vote_frame);
+    CHECK(twice.vote.score == once.vote.score);
+    CHECK(same_bits(twice.rotation, once.rotation));
+    CHECK(same_bits(twice.vote.rotation, once.vote.rotation));
+    ulc::MapTerraOptions three = o;
+    three.motion.unsure_vote_frames = 0;
+    CHECK(motion(three).votes == 3);
   }
 }
