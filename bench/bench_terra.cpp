@@ -895,7 +895,7 @@ int main(int argc, char** argv) {
       ->type_name("N")
       ->check(CLI::PositiveNumber);
   app.add_option("--unsure-vote-frames", mo.unsure_vote_frames,
-                 "--maps/--windows: frames the vote uses where the first leave it unsure "
+                 "--maps/--windows: frames the vote uses where none of the first is sure "
                  "(default 5; 0: none)")
       ->type_name("N");
   app.add_option("--starts", mo.starts, "--maps: windows per pair (default 8)")

@@ -14,8 +14,8 @@
 //
 // Conventions this header owns:
 //   - Frames voted: `count` of the window's target frames evenly spaced from its first to its
-//     last (count 1: the anchor frame alone, the map's own frame). Five spaced so hold the
-//     three (map_terra.hpp votes them where none of the three is sure).
+//     last (count 1: the anchor frame alone, the map's own frame). Five frames so spaced
+//     include the three (map_terra.hpp votes five where none of the three is sure).
 //   - Tally: each confident vote's support is the number of confident votes within agree_deg of
 //     its rotation (itself included). The window's answer is the vote with the most support
 //     (ties: the higher score, then the earlier frame); none when a confident vote more than
