@@ -69,6 +69,14 @@ TurnedTele turned_tele(const ulc::sim::Dataset& d, terra::SplitMix64& rng) {
   return t;
 }
 
+/// 2 s windows whose ground and travel is refused, so that the ground vote alone answers.
+ulc::MapTerraOptions vote_alone_options() {
+  ulc::MapTerraOptions o;
+  o.window_s = 2.0;
+  o.motion.max_travel_mismatch = 0.0;
+  return o;
+}
+
 }  // namespace
 
 TEST_CASE("TERRA on 3 s local maps finds the 64-tele rotation that single frames miss",
@@ -269,9 +277,7 @@ TEST_CASE("the ground vote gives the 64-tele rotation from Tele frames, no targe
   const auto& b = d.lidars[1];
   terra::SplitMix64 rng(12);
   const auto [turned, truth] = turned_tele(d, rng);
-  ulc::MapTerraOptions o;
-  o.window_s = 2.0;
-  o.motion.max_travel_mismatch = 0.0;  // the ground and travel refuse: the vote alone answers
+  const ulc::MapTerraOptions o = vote_alone_options();
   // Five windows 0.3 s apart: the vote answers where it is sure, and is right where it answers.
   std::size_t confident = 0;
   for (std::size_t k = 0; k < 5; ++k) {
@@ -346,9 +352,7 @@ TEST_CASE("where none of the first three frames is sure, five vote, as if voted 
   const auto& b = d.lidars[1];
   terra::SplitMix64 rng(12);
   const auto turned = turned_tele(d, rng).frames;
-  ulc::MapTerraOptions o;
-  o.window_s = 2.0;
-  o.motion.max_travel_mismatch = 0.0;  // the ground and travel refuse: the vote alone answers
+  ulc::MapTerraOptions o = vote_alone_options();
   const auto motion = [&](const ulc::MapTerraOptions& options) {
     return ulc::build_local_maps(a.frames, a.timestamps, turned, b.timestamps, start_index(d),
                                  options)
