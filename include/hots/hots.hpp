@@ -133,11 +133,7 @@ RefineResult refine(const SeqA& a, const SeqB& b, const Isometry3d& extrinsic,
   done(0.41);
   const bool linked = d::link_lidars(s, options.time_offset_s, options, st, within(0.41, 0.68));
   done(0.68);
-  if (!linked)
-    return fail(RefineStatus::extrinsic_unconfirmed,
-                "too few of the cross links (b's submaps registered to a's through the "
-                "extrinsic) agree with it: the two LiDARs' views do not confirm the extrinsic "
-                "(statistics: cross_links_agreeing of cross_links_attempted)");
+  if (!linked) return fail(RefineStatus::extrinsic_unconfirmed, d::unconfirmed_reason(st));
   d::build_graph(s, extrinsic, options, st);
   if (const RefineStatus status = d::solve_passes(s, options, result); status != RefineStatus::ok)
     return fail(status, result.reason);

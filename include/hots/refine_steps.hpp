@@ -63,6 +63,23 @@ inline bool links_confirm(const RefineStatistics& st, const RefineOptions& optio
   return static_cast<double>(st.cross_links_agreeing) >= needed;
 }
 
+/// Why the cross links did not confirm the extrinsic. None kept (every registration failed or
+/// left too few of b's points on a's surfaces, CrossLinkOptions::min_inlier_ratio) says the
+/// views overlap too little to judge: 64-tele seed 2's right extrinsic kept none of 90, its
+/// links' inlier ratios 0.12-0.26, the Tele's far points beyond the HDL-64E frame
+/// (docs/experiments/tele_cross_links.md). Kept links moving away from their prediction say
+/// the extrinsic is wrong.
+inline const char* unconfirmed_reason(const RefineStatistics& st) {
+  if (st.cross_links == 0)
+    return "none of the cross links (b's submaps registered to a's through the extrinsic) kept "
+           "enough of b's points on a's surfaces: the two LiDARs' views overlap too little for "
+           "HOTS to judge the extrinsic, right or wrong (statistics: cross_links of "
+           "cross_links_attempted)";
+  return "too few of the cross links (b's submaps registered to a's through the extrinsic) agree "
+         "with it: the two LiDARs' views do not confirm the extrinsic (statistics: "
+         "cross_links_agreeing of cross_links_attempted)";
+}
+
 /// Seconds since `start`, and `start` moved to now: consecutive phases of one run.
 inline double lap(std::chrono::steady_clock::time_point& start) {
   const auto now = std::chrono::steady_clock::now();

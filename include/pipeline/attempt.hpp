@@ -258,14 +258,23 @@ inline void add_refine(HotsReport& h, const hots::RefineResult& r, double second
   h.seconds = seconds;
 }
 
+/// What an unconfirmed extrinsic's cross links say: no link kept, so nothing is known of the
+/// extrinsic; or links kept and too few agreeing, so it is likely wrong.
+inline std::string unconfirmed_hint(const hots::RefineStatistics& st) {
+  const std::string attempted = std::to_string(st.cross_links_attempted);
+  if (st.cross_links == 0)
+    return "; 0 of " + attempted +
+           " registered with enough overlap: neither confirmed nor refuted (a drive on which "
+           "the LiDARs see more of the same surfaces can judge it)";
+  return "; " + std::to_string(st.cross_links_agreeing) + " of " + attempted +
+         " agree: the extrinsic before HOTS is likely wrong (TERRA's rotation or the initial "
+         "guess)";
+}
+
 /// One sentence for a failed HOTS, with what to do about it.
 inline std::string hots_failure(const hots::RefineResult& h) {
   std::string why = std::string("HOTS: ") + hots::to_string(h.status) + ": " + h.reason;
-  if (h.status == hots::RefineStatus::extrinsic_unconfirmed)
-    why += "; " + std::to_string(h.statistics.cross_links_agreeing) + " of " +
-           std::to_string(h.statistics.cross_links_attempted) +
-           " agree: the extrinsic before HOTS is likely wrong (TERRA's rotation or the initial "
-           "guess)";
+  if (h.status == hots::RefineStatus::extrinsic_unconfirmed) why += unconfirmed_hint(h.statistics);
   if (h.status == hots::RefineStatus::time_offset_untrusted)
     why +=
         "; a longer drive with turns and speed changes pins it down, and synchronised clocks "

@@ -3,7 +3,8 @@
 // the 64-32 mounting and its result entry carries HOTS's statistics and covariance; a known
 // offset reaches every stage; a failing odometry or HOTS ends the call with hots_failed and
 // keeps the extrinsic HOTS started from; the base's own odometry is run once and can be handed on,
-// and the joint odometry gives the same answer within a millimetre.
+// and the joint odometry gives the same answer within a millimetre; an unconfirmed extrinsic says
+// whether its cross links refuted it or none registered.
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <limits>
@@ -255,4 +256,42 @@ TEST_CASE("HOTS from the base's own odometry: run once, handed on, the joint one
   CHECK(ej.translation_m < 0.10);
   CHECK(between.rotation_deg < 0.05);
   CHECK(between.translation_m < 0.01);
+}
+
+TEST_CASE("an unconfirmed extrinsic says whether its links refuted it or none registered",
+          "[calibrate][hots][status]") {
+  const auto& d = drive_64_32_hots();
+  const auto& a = d.lidars[0];
+  const auto& b = d.lidars[1];
+  ulc::CalibrateOptions o;
+  o.stages = {Stage::hots};
+  o.time_offset_s = 0.0;
+  o.initial = d.pairs[0].T_base_target;  // the truth: only the options below refuse it
+  const auto unconfirmed = [&](const ulc::CalibrateOptions& options) {
+    const auto c = ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, options);
+    INFO(c.reason);
+    CHECK(c.status == CalibrateStatus::hots_failed);
+    REQUIRE(c.hots);
+    CHECK(c.hots->status == hots::RefineStatus::extrinsic_unconfirmed);
+    CHECK(c.hots->statistics.cross_links_attempted > 0);
+    return c;
+  };
+
+  SECTION("no link kept: neither confirmed nor refuted") {
+    o.tuning.hots.links.min_inlier_ratio = 1.1;  // no registration keeps that many inliers
+    const auto c = unconfirmed(o);
+    CHECK(c.hots->statistics.cross_links == 0);
+    CHECK_THAT(c.reason, Catch::Contains("overlap too little for HOTS to judge the extrinsic"));
+    CHECK_THAT(c.reason, Catch::Contains("registered with enough overlap: neither confirmed"));
+    CHECK_THAT(c.reason, !Catch::Contains("likely wrong"));
+  }
+  SECTION("links kept, none agreeing: likely wrong") {
+    o.tuning.hots.links.agree_translation_m = 0.0;  // every link moves a little: none agrees
+    const auto c = unconfirmed(o);
+    CHECK(c.hots->statistics.cross_links > 0);
+    CHECK(c.hots->statistics.cross_links_agreeing == 0);
+    CHECK_THAT(c.reason, Catch::Contains("too few of the cross links"));
+    CHECK_THAT(c.reason, Catch::Contains("likely wrong"));
+    CHECK_THAT(c.reason, !Catch::Contains("overlap too little"));
+  }
 }
