@@ -66,7 +66,7 @@ inline bool links_confirm(const RefineStatistics& st, const RefineOptions& optio
 /// Why the cross links did not confirm the extrinsic. None kept (every registration failed or
 /// left too few of b's points on a's surfaces, CrossLinkOptions::min_inlier_ratio) says the
 /// views overlap too little to judge: 64-tele seed 2's right extrinsic kept none of 90, its
-/// links' inlier ratios 0.12-0.26, the Tele's far points beyond the HDL-64E frame
+/// links' inlier ratios 0.12-0.26, the Tele's far points beyond the HDL-64E's frames and submaps
 /// (docs/experiments/tele_cross_links.md). Kept links moving away from their prediction say
 /// the extrinsic is wrong.
 inline const char* unconfirmed_reason(const RefineStatistics& st) {
