@@ -286,7 +286,7 @@ TEST_CASE("an unconfirmed extrinsic says whether its links refuted it or none re
     CHECK_THAT(c.reason, !Catch::Contains("likely wrong"));
   }
   SECTION("links kept, none agreeing: likely wrong") {
-    o.tuning.hots.links.agree_translation_m = 0.0;  // every link moves a little: none agrees
+    o.tuning.hots.links.agree_translation_m = 0.0;  // no move is under 0 m: none agrees
     const auto c = unconfirmed(o);
     CHECK(c.hots->statistics.cross_links > 0);
     CHECK(c.hots->statistics.cross_links_agreeing == 0);
