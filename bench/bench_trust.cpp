@@ -135,7 +135,7 @@ void bench(const Config& c) {
                                    ? static_cast<double>(st.cross_links_agreeing) /
                                          static_cast<double>(st.cross_links_attempted)
                                    : 0.0;
-          const bool confirmed = hots::hots_detail::links_confirm(st, o.tuning.hots);
+          const bool confirmed = hots::confirms(hots::hots_detail::judge_links(st, o.tuning.hots));
           const bool right = ulc::is_calibration_success(he);
           (right ? m.right : m.wrong) += 1;
           if (right) {

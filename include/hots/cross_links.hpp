@@ -17,7 +17,9 @@
 //     information (Hessian of fewer points) is smaller, which weights links less against the
 //     windows' BA; accuracy did not suffer from that (scaling it back up was worse).
 //   - A link is kept when the registration is ok and its inlier ratio >= min_inlier_ratio
-//     (register_clouds, also used by boundary_links.hpp).
+//     (register_clouds, also used by boundary_links.hpp). CrossLinkStats also counts the
+//     registrations that converged but were not kept, and their median inlier ratio: what
+//     tells "the views overlap too little" from "the links refuse the extrinsic".
 //   - A kept link agrees with the extrinsic when the registration moved less than
 //     agree_rotation_rad and agree_translation_m from its start (CrossLink::moved_*): the start
 //     is the prediction of the odometry's poses and the current extrinsic, good to a few
@@ -40,6 +42,7 @@
 
 #include "hots/hierarchy.hpp"
 #include "hots/options.hpp"
+#include "hots/refine_statistics.hpp"
 #include "ulc/core/batched_for.hpp"
 #include "ulc/core/nearest_time.hpp"
 #include "ulc/core/point_to_plane.hpp"
@@ -60,8 +63,32 @@ struct CrossLink {
 struct CrossLinkStats {
   std::size_t attempted = 0;
   std::size_t kept = 0;
-  std::size_t agreeing = 0;  ///< kept links that moved less than the agree_* bounds
+  std::size_t agreeing = 0;   ///< kept links that moved less than the agree_* bounds
+  std::size_t converged = 0;  ///< registrations that converged, kept or not
+  /// Weak links: converged, not kept, inlier ratio >= weak_inlier_ratio; and of those the ones
+  /// within the agree_* bounds (docs/experiments/tele_cross_links.md).
+  std::size_t weak = 0, weak_agreeing = 0;
+  /// Median inlier ratio of the converged registrations (0 when none): how much of b's view
+  /// lies on a's surfaces, against CrossLinkOptions::min_inlier_ratio.
+  double inlier_ratio_median = 0.0;
+  std::vector<CrossLinkRecord> records;  ///< every registration, in (layer, a member) order
 };
+
+/// One registration of b's cloud to a's planes before the keep rule: whether it converged, its
+/// inlier ratio, and the link it measured (meaningful when converged).
+struct LinkRegistration {
+  bool converged = false;
+  double inlier_ratio = 0.0;
+  CrossLink link;
+  bool kept(const CrossLinkOptions& options) const {
+    return converged && inlier_ratio >= options.min_inlier_ratio;
+  }
+};
+
+/// Whether a link moved less than the agree_* bounds from its start (see the conventions).
+inline bool agrees(const CrossLink& link, const CrossLinkOptions& options) {
+  return link.moved_rad < options.agree_rotation_rad && link.moved_m < options.agree_translation_m;
+}
 
 namespace cross_link_detail {
 
@@ -85,26 +112,58 @@ const std::vector<ulc::Vec3<S>>& thinned(const std::vector<ulc::Vec3<S>>& cloud,
   return storage;
 }
 
+/// One registration counted into `stats`; a converged one's inlier ratio appended to `ratios`.
+inline void tally(const LinkRegistration& r, const CrossLinkOptions& options, CrossLinkStats& stats,
+                  std::vector<double>& ratios) {
+  ++stats.attempted;
+  stats.records.push_back(
+      {r.link.layer, r.converged, r.inlier_ratio, r.link.moved_rad, r.link.moved_m});
+  if (!r.converged) return;
+  ++stats.converged;
+  ratios.push_back(r.inlier_ratio);
+  const std::size_t agreeing = agrees(r.link, options) ? 1 : 0;
+  if (r.kept(options)) {
+    ++stats.kept;
+    stats.agreeing += agreeing;
+  } else if (r.inlier_ratio >= options.weak_inlier_ratio) {
+    ++stats.weak;
+    stats.weak_agreeing += agreeing;
+  }
+}
+
+/// The median of `values` (the mean of the middle two for an even count); 0 when empty.
+inline double median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  const std::size_t mid = values.size() / 2;
+  std::nth_element(values.begin(), values.begin() + mid, values.end());
+  const double upper = values[mid];
+  if (values.size() % 2 == 1) return upper;
+  return 0.5 * (upper + *std::max_element(values.begin(), values.begin() + mid));
+}
+
 }  // namespace cross_link_detail
 
-/// `source` registered to `target`'s planes from `initial` (both thinned first): the measured
-/// T_target_source and its information, or nothing when the registration is unusable
-/// (anchors and layer are left for the caller).
+/// `source` registered to `target`'s planes from `initial` (both thinned first): whether it
+/// converged, its inlier ratio and the measured T_target_source with its information (anchors
+/// and layer are left for the caller).
 template <typename S>
-std::optional<CrossLink> register_clouds(const std::vector<ulc::Vec3<S>>& target,
-                                         const std::vector<ulc::Vec3<S>>& source,
-                                         const Isometry3d& initial, const CrossLinkOptions& options,
-                                         const std::vector<ulc::RegistrationOptions>& stages) {
-  if (target.empty() || source.empty()) return std::nullopt;
+LinkRegistration register_link(const std::vector<ulc::Vec3<S>>& target,
+                               const std::vector<ulc::Vec3<S>>& source, const Isometry3d& initial,
+                               const CrossLinkOptions& options,
+                               const std::vector<ulc::RegistrationOptions>& stages) {
+  LinkRegistration out;
+  if (target.empty() || source.empty()) return out;
   std::vector<ulc::Vec3<S>> thin_target, thin_source;
   const ulc::PlaneCloud<S> planes(
       cross_link_detail::thinned(target, options.target_voxel, thin_target), options.planes);
-  if (planes.empty()) return std::nullopt;
+  if (planes.empty()) return out;
   const auto reg = ulc::register_point_to_plane(
       cross_link_detail::thinned(source, options.source_voxel, thin_source), planes, initial,
       stages);
-  if (!reg.ok() || reg.inlier_ratio() < options.min_inlier_ratio) return std::nullopt;
-  CrossLink link;
+  if (!reg.ok()) return out;
+  out.converged = true;
+  out.inlier_ratio = reg.inlier_ratio();
+  CrossLink& link = out.link;
   link.measured = reg.pose.template cast<double>();
   const double sigma = std::max(reg.rmse, options.min_sigma);
   link.information = reg.hessian / (sigma * sigma);
@@ -112,7 +171,19 @@ std::optional<CrossLink> register_clouds(const std::vector<ulc::Vec3<S>>& target
   const Isometry3d moved = initial.inverse() * link.measured;
   link.moved_rad = Eigen::AngleAxisd(moved.linear()).angle();
   link.moved_m = moved.translation().norm();
-  return link;
+  return out;
+}
+
+/// register_link's link when it is kept (converged, inlier ratio >= min_inlier_ratio), or
+/// nothing when the registration is unusable.
+template <typename S>
+std::optional<CrossLink> register_clouds(const std::vector<ulc::Vec3<S>>& target,
+                                         const std::vector<ulc::Vec3<S>>& source,
+                                         const Isometry3d& initial, const CrossLinkOptions& options,
+                                         const std::vector<ulc::RegistrationOptions>& stages) {
+  LinkRegistration r = register_link(target, source, initial, options, stages);
+  if (!r.kept(options)) return std::nullopt;
+  return std::move(r.link);
 }
 
 /// progress (optional) gets the fraction of registrations done, on the calling thread, every
@@ -137,13 +208,15 @@ std::vector<CrossLink> cross_links(
     total += chosen[l].size();
   }
   const auto stages = ulc::coarse_to_fine_stages(options.gate);
+  CrossLinkStats counts;
+  std::vector<double> ratios;  // the converged registrations' inlier ratios
   for (std::size_t l = first_layer; l < layers; ++l) {
     const auto& ma = ha.members[l];
     const auto& mb = hb.members[l];
     if (chosen[l].empty()) continue;
     std::vector<double> tb;
     for (const auto& m : mb) tb.push_back(times_b[m.begin] + time_offset_s);
-    std::vector<std::optional<CrossLink>> slot(chosen[l].size());
+    std::vector<LinkRegistration> slot(chosen[l].size());
     ulc::parallel_for_in_batches(
         chosen[l].size(), ulc::default_batch_size(),
         [&](std::size_t c) {
@@ -152,27 +225,23 @@ std::vector<CrossLink> cross_links(
           const auto& cloud_a = l == 0 ? frames_a[a.begin] : a.cloud;
           const auto& cloud_b = l == 0 ? frames_b[b.begin] : b.cloud;
           const Isometry3d initial = poses_a[a.begin].inverse() * poses_b[b.begin];
-          slot[c] = register_clouds(cloud_a, cloud_b, initial, options, stages);
-          if (!slot[c]) return;
-          slot[c]->frame_a = a.begin;
-          slot[c]->frame_b = b.begin;
-          slot[c]->layer = static_cast<int>(l);
+          slot[c] = register_link(cloud_a, cloud_b, initial, options, stages);
+          slot[c].link.frame_a = a.begin;
+          slot[c].link.frame_b = b.begin;
+          slot[c].link.layer = static_cast<int>(l);
         },
         [&](std::size_t done) {
           if (progress)
             progress(static_cast<double>(done_before + done) / static_cast<double>(total));
         });
     done_before += chosen[l].size();
-    for (const auto& link : slot) {
-      if (stats) ++stats->attempted;
-      if (!link) continue;
-      if (stats) ++stats->kept;
-      if (stats && link->moved_rad < options.agree_rotation_rad &&
-          link->moved_m < options.agree_translation_m)
-        ++stats->agreeing;
-      links.push_back(*link);
+    for (const auto& r : slot) {
+      d::tally(r, options, counts, ratios);
+      if (r.kept(options)) links.push_back(r.link);
     }
   }
+  counts.inlier_ratio_median = d::median(std::move(ratios));
+  if (stats) *stats = counts;
   return links;
 }
 

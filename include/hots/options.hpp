@@ -88,6 +88,9 @@ struct CrossLinkOptions {
   double target_voxel = 0.5;  ///< m, a's cloud (planes) thinning; 0: none
   double gate = 1.0;          ///< first registration stage's gate, m
   double min_inlier_ratio = 0.3;
+  /// A converged registration under min_inlier_ratio counts as a weak link when its inlier
+  /// ratio reaches this: reported (CrossLinkStats), not used.
+  double weak_inlier_ratio = 0.1;
   double min_sigma = 0.01;                                     ///< m
   double agree_rotation_rad = 1.0 * 3.14159265358979 / 180.0;  ///< see the conventions
   double agree_translation_m = 1.0;

@@ -107,11 +107,49 @@ inline const char* to_string(RefineStatus s) {
   }
 }
 
+/// What the cross links said of the extrinsic HOTS started from (refine_steps.hpp,
+/// judge_links): enough kept links agree; too few do; or none was kept, too little overlap to
+/// judge. not_judged: the rule is off or no link was tried.
+enum class LinkVerdict { not_judged, kept_links_agree, kept_links_refute, too_little_overlap };
+
+inline const char* to_string(LinkVerdict v) {
+  switch (v) {
+    case LinkVerdict::kept_links_agree:
+      return "kept_links_agree";
+    case LinkVerdict::kept_links_refute:
+      return "kept_links_refute";
+    case LinkVerdict::too_little_overlap:
+      return "too_little_overlap";
+    default:
+      return "not_judged";
+  }
+}
+
+inline bool confirms(LinkVerdict v) {
+  return v == LinkVerdict::not_judged || v == LinkVerdict::kept_links_agree;
+}
+
+/// One cross-link registration as HOTS tried it (cross_links.hpp): its layer, whether it
+/// converged, its inlier ratio and how far it moved from its start. It was kept when it
+/// converged with inlier_ratio >= CrossLinkOptions::min_inlier_ratio, and agreed when it moved
+/// less than the agree bounds.
+struct CrossLinkRecord {
+  int layer = 0;
+  bool converged = false;
+  double inlier_ratio = 0.0, moved_rad = 0.0, moved_m = 0.0;
+};
+
 struct RefineStatistics {
   std::size_t windows = 0, failed_windows = 0, planes = 0;
   std::size_t ba_factors = 0, cross_links = 0, cross_links_attempted = 0, extrinsic_ties = 0;
   std::size_t cross_links_agreeing = 0;  ///< kept links that confirm the start (cross_links.hpp)
-  std::size_t boundary_factors = 0;      ///< top-layer submap boundaries tied in the graph
+  /// Cross-link registrations that converged, kept or not, and their median inlier ratio; the
+  /// weak links and those of them that agree (CrossLinkStats).
+  std::size_t cross_links_converged = 0, cross_links_weak = 0, cross_links_weak_agreeing = 0;
+  double cross_link_inlier_ratio_median = 0.0;
+  LinkVerdict link_verdict = LinkVerdict::not_judged;  ///< the trust rule on the cross links
+  std::vector<CrossLinkRecord> cross_link_records;     ///< every registration, in link order
+  std::size_t boundary_factors = 0;  ///< top-layer submap boundaries tied in the graph
   std::size_t boundary_links = 0;    ///< of those, by registering the submaps (the rest: odometry)
   std::size_t boundary_bridges = 0;  ///< boundaries tied by a bridge BA (not in boundary_factors)
   bool prepared_a_reused = false;    ///< a's preparation came from the caller (refine's prepared_a)

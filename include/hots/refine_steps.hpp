@@ -54,30 +54,35 @@ bool built_from(const PreparedLidar<S>& prepared, const std::vector<Isometry3d>&
 
 namespace hots_detail {
 
-/// The trust rule on the cross links (see the conventions); no attempt: nothing to judge.
-inline bool links_confirm(const RefineStatistics& st, const RefineOptions& options) {
-  if (!(options.min_cross_link_ratio > 0.0) || st.cross_links_attempted == 0) return true;
+/// The trust rule on the cross links (see the conventions): enough kept links agree, too few
+/// do, or none was kept (too little overlap to judge: HOTS has no evidence for the extrinsic
+/// and refuses it too). No attempt: nothing to judge.
+inline LinkVerdict judge_links(const RefineStatistics& st, const RefineOptions& options) {
+  if (!(options.min_cross_link_ratio > 0.0) || st.cross_links_attempted == 0)
+    return LinkVerdict::not_judged;
+  if (st.cross_links == 0) return LinkVerdict::too_little_overlap;
   const double needed =
       std::max(static_cast<double>(options.min_cross_links),
                options.min_cross_link_ratio * static_cast<double>(st.cross_links_attempted));
-  return static_cast<double>(st.cross_links_agreeing) >= needed;
+  return static_cast<double>(st.cross_links_agreeing) >= needed ? LinkVerdict::kept_links_agree
+                                                                : LinkVerdict::kept_links_refute;
 }
 
-/// Why the cross links did not confirm the extrinsic. None kept (every registration failed or
-/// left too few of b's points on a's surfaces, CrossLinkOptions::min_inlier_ratio) says the
-/// views overlap too little to judge: 64-tele seed 2's right extrinsic kept none of 90, its
-/// links' inlier ratios 0.12-0.26, the Tele's far points beyond the HDL-64E's frames and submaps
-/// (docs/experiments/tele_cross_links.md). Kept links moving away from their prediction say
-/// the extrinsic is wrong.
-inline const char* unconfirmed_reason(const RefineStatistics& st) {
-  if (st.cross_links == 0)
-    return "none of the cross links (b's submaps registered to a's through the extrinsic) kept "
-           "enough of b's points on a's surfaces: the two LiDARs' views overlap too little for "
-           "HOTS to judge the extrinsic, right or wrong (statistics: cross_links of "
-           "cross_links_attempted)";
-  return "too few of the cross links (b's submaps registered to a's through the extrinsic) agree "
-         "with it: the two LiDARs' views do not confirm the extrinsic (statistics: "
-         "cross_links_agreeing of cross_links_attempted)";
+/// Why the cross links did not confirm the extrinsic. Kept links moving away from their
+/// prediction say it is wrong. None kept (every registration failed or left too few of b's
+/// points on a's surfaces, CrossLinkOptions::min_inlier_ratio) says the views overlap too little
+/// to judge: 64-tele seed 2's right extrinsic kept none of 90, its links' inlier ratios
+/// 0.12-0.26, the Tele's far points beyond the HDL-64E's frames and submaps
+/// (docs/experiments/tele_cross_links.md).
+inline const char* unconfirmed_reason(LinkVerdict verdict) {
+  if (verdict == LinkVerdict::kept_links_refute)
+    return "too few of the cross links (b's submaps registered to a's through the extrinsic) "
+           "agree with it: the two LiDARs' views do not confirm the extrinsic (statistics: "
+           "cross_links_agreeing of cross_links_attempted)";
+  return "none of the cross links (b's submaps registered to a's through the extrinsic) kept "
+         "enough of b's points on a's surfaces: the two LiDARs' views overlap too little for "
+         "HOTS to judge the extrinsic, right or wrong (statistics: cross_links of "
+         "cross_links_attempted)";
 }
 
 /// Seconds since `start`, and `start` moved to now: consecutive phases of one run.
@@ -336,7 +341,7 @@ void build_hierarchies(RefineState<S>& s, const RefineOptions& options, RefineSt
 }
 
 /// The cross links between the LiDARs (cross_links.hpp); false when too few agree with the
-/// extrinsic (see links_confirm). Then each LiDAR's top-layer boundaries registered
+/// extrinsic (see judge_links). Then each LiDAR's top-layer boundaries registered
 /// (boundary_links.hpp) (statistics: cross_links).
 /// progress gets the fraction of cross links registered.
 template <typename S>
@@ -348,9 +353,15 @@ bool link_lidars(RefineState<S>& s, double time_offset_s, const RefineOptions& o
   st.cross_links = s.links.size();
   st.cross_links_attempted = link_stats.attempted;
   st.cross_links_agreeing = link_stats.agreeing;
+  st.cross_links_converged = link_stats.converged;
+  st.cross_links_weak = link_stats.weak;
+  st.cross_links_weak_agreeing = link_stats.weak_agreeing;
+  st.cross_link_inlier_ratio_median = link_stats.inlier_ratio_median;
+  st.cross_link_records = std::move(link_stats.records);
   // Decided here, before the graph, the synchronisation and the sequence step: their work
   // would rest on an extrinsic the views refuse (and a caller trying several is spared it).
-  if (!links_confirm(st, options)) return false;
+  st.link_verdict = judge_links(st, options);
+  if (!confirms(st.link_verdict)) return false;
   if (options.boundary_registration)
     for (RefineLidar<S>* l : {&s.a, &s.b})
       l->boundaries = boundary_links(l->hierarchy, l->frames, l->world, options.links,

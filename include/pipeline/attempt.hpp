@@ -37,6 +37,7 @@
 #include "pipeline/odometry_choice.hpp"
 #include "pipeline/options.hpp"
 #include "pipeline/pair_calibration.hpp"
+#include "pipeline/text_format.hpp"
 #include "ulc/core/frame_range.hpp"
 #include "ulc/core/lidar_sequence.hpp"
 
@@ -258,17 +259,22 @@ inline void add_refine(HotsReport& h, const hots::RefineResult& r, double second
   h.seconds = seconds;
 }
 
-/// What an unconfirmed extrinsic's cross links say: no link kept, so nothing is known of the
-/// extrinsic; or links kept and too few agreeing, so it is likely wrong.
+/// What an unconfirmed extrinsic's cross links say: kept links refuting it, so it is likely
+/// wrong; or none kept, so nothing is known of it, with what the weak links saw (reported, not
+/// used: hots/hots.hpp).
 inline std::string unconfirmed_hint(const hots::RefineStatistics& st) {
   const std::string attempted = std::to_string(st.cross_links_attempted);
-  if (st.cross_links == 0)
-    return "; 0 of " + attempted +
-           " registered with enough overlap: neither confirmed nor refuted (a drive on which "
-           "the LiDARs see more of the same surfaces can judge it)";
-  return "; " + std::to_string(st.cross_links_agreeing) + " of " + attempted +
-         " agree: the extrinsic before HOTS is likely wrong (TERRA's rotation or the initial "
-         "guess)";
+  if (st.link_verdict == hots::LinkVerdict::kept_links_refute)
+    return "; " + std::to_string(st.cross_links_agreeing) + " of " + attempted +
+           " agree: the extrinsic before HOTS is likely wrong (TERRA's rotation or the initial "
+           "guess)";
+  return "; 0 of " + attempted + " registered with enough overlap (" +
+         std::to_string(st.cross_links_converged) + " converged, with a median inlier ratio of " +
+         fixed(st.cross_link_inlier_ratio_median, 2) + ", and " +
+         std::to_string(st.cross_links_weak_agreeing) + " of the " +
+         std::to_string(st.cross_links_weak) +
+         " weak ones agree): neither confirmed nor refuted (a drive on which the LiDARs "
+         "see more of the same surfaces can judge it)";
 }
 
 /// One sentence for a failed HOTS, with what to do about it.

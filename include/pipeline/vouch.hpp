@@ -27,7 +27,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
-#include <cstdio>
 #include <string>
 #include <tuple>
 #include <type_traits>
@@ -40,6 +39,7 @@
 #include "pipeline/confidence.hpp"
 #include "pipeline/motion_lag.hpp"
 #include "pipeline/pair_calibration.hpp"
+#include "pipeline/text_format.hpp"
 #include "ulc/core/point_traits.hpp"
 
 namespace ulc {
@@ -57,16 +57,6 @@ PointTimesReport point_times_of(const Frames& frames) {
              " frame(s) carry no per-point time: their sweeps are not deskewed";
   }
   return r;
-}
-
-inline std::string fixed(double v, int digits) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, "%.*f", digits, v);
-  return buffer;
-}
-
-inline std::string cm(double metres) {
-  return fixed(metres * 100.0, 1) + " cm";
 }
 
 /// The first frames of a view, up to a count: the lag check's window.

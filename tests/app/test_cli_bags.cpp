@@ -60,8 +60,8 @@ const BagDrive& drive() {
 ulc::io::PairResult calibrate(const std::string& base, const std::string& target,
                               const std::string& out) {
   const auto run =
-      run_command(kUlc + " calibrate --quiet --synced-clocks --stages terra,jeep --base " + quote(base) +
-                  " --target " + quote(target) + " --output " + quote(out));
+      run_command(kUlc + " calibrate --quiet --synced-clocks --stages terra,jeep --base " +
+                  quote(base) + " --target " + quote(target) + " --output " + quote(out));
   INFO(run.output);
   REQUIRE(run.exit_code == 0);
   const auto r = ulc::io::read_result_file(out);

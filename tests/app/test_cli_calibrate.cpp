@@ -293,6 +293,14 @@ TEST_CASE("ulc calibrate --stages hots is accepted and runs odometry and HOTS ov
   const auto& synced_hots = rs[0].stages.at("hots");
   CHECK(synced_hots.at("time_offset_checked").get<bool>() == false);
   CHECK(synced_hots.at("time_sync_pairs").get<double>() == 0);  // the synchronisation never ran
+  // Every cross-link registration is in the file, one row each; the counts agree with it.
+  const auto& registrations = synced_hots.at("cross_link_registrations");
+  CHECK(registrations.at("columns").size() == 5);
+  const auto& rows = registrations.at("rows");
+  CHECK(rows.size() == synced_hots.at("cross_links_attempted").get<std::size_t>());
+  std::size_t converged = 0;
+  for (const auto& row : rows) converged += row.at(1).get<int>();
+  CHECK(converged == synced_hots.at("cross_links_converged").get<std::size_t>());
 
   // --base-odometry: the base's own odometry and HOTS's preparation of its frames, done for the
   // first target and reused by the second (the same LiDAR under another name), whose answer is

@@ -70,10 +70,10 @@ TEST_CASE("ulc calibrate on a rig: a route through another LiDAR, cycle closures
           "[app][calibrate][rig]") {
   const RigDataset d("ulc_test_cli_rig");
   const std::string out = d.file("result.json");
-  const auto run =
-      run_command(kUlc + " calibrate --synced-clocks --stages terra,jeep --base " + d.lidar("bpearl_left") +
-                  " --target " + d.lidar("helios_front") + " --target " + d.lidar("helios_rear") +
-                  " --target " + d.lidar("bpearl_right") + " --output " + quote(out));
+  const auto run = run_command(kUlc + " calibrate --synced-clocks --stages terra,jeep --base " +
+                               d.lidar("bpearl_left") + " --target " + d.lidar("helios_front") +
+                               " --target " + d.lidar("helios_rear") + " --target " +
+                               d.lidar("bpearl_right") + " --output " + quote(out));
   INFO(run.output);
   REQUIRE(run.exit_code == 0);  // every target calibrated, one of them routed
 
@@ -144,10 +144,10 @@ TEST_CASE("ulc calibrate --no-route leaves the unseen target failed; --no-cycles
           "[app][calibrate][rig]") {
   const RigDataset d("ulc_test_cli_rig_flags");
   const std::string out = d.file("result.yaml");
-  const auto run = run_command(kUlc + " calibrate --quiet --synced-clocks --no-route --no-cycles --stages " +
-                               "terra,jeep --base " + d.lidar("bpearl_left") + " --target " +
-                               d.lidar("helios_front") + " --target " + d.lidar("bpearl_right") +
-                               " --format yaml --output " + quote(out));
+  const auto run = run_command(
+      kUlc + " calibrate --quiet --synced-clocks --no-route --no-cycles --stages " +
+      "terra,jeep --base " + d.lidar("bpearl_left") + " --target " + d.lidar("helios_front") +
+      " --target " + d.lidar("bpearl_right") + " --format yaml --output " + quote(out));
   INFO(run.output);
   CHECK(run.exit_code == 1);  // ran, but one target did not calibrate
   CHECK_THAT(run.output, Catch::Contains("bpearl_left <- bpearl_right: jeep_failed"));

@@ -258,7 +258,7 @@ TEST_CASE("HOTS from the base's own odometry: run once, handed on, the joint one
   CHECK(between.translation_m < 0.01);
 }
 
-TEST_CASE("an unconfirmed extrinsic says whether its links refuted it or none registered",
+TEST_CASE("the cross links confirm, refute, or cannot judge the extrinsic HOTS starts from",
           "[calibrate][hots][status]") {
   const auto& d = drive_64_32_hots();
   const auto& a = d.lidars[0];
@@ -280,9 +280,22 @@ TEST_CASE("an unconfirmed extrinsic says whether its links refuted it or none re
   SECTION("no link kept: neither confirmed nor refuted") {
     o.tuning.hots.links.min_inlier_ratio = 1.1;  // no registration keeps that many inliers
     const auto c = unconfirmed(o);
-    CHECK(c.hots->statistics.cross_links == 0);
+    const auto& st = c.hots->statistics;
+    CHECK(st.cross_links == 0);
+    CHECK(st.link_verdict == hots::LinkVerdict::too_little_overlap);
+    // From the truth the registrations still converge where they started, with the overlap a
+    // kept link needs by default (0.3): as weak links they agree, which is reported, not used.
+    CHECK(st.cross_links_weak_agreeing >= 3);
+    CHECK(st.cross_links_weak <= st.cross_links_converged);
+    CHECK(st.cross_link_inlier_ratio_median > 0.3);
+    CHECK(st.cross_link_inlier_ratio_median <= 1.0);
+    REQUIRE(st.cross_link_records.size() == st.cross_links_attempted);
+    std::size_t converged = 0;
+    for (const auto& r : st.cross_link_records) converged += r.converged ? 1 : 0;
+    CHECK(converged == st.cross_links_converged);
+    CHECK_THAT(c.reason, Catch::Contains("converged, with a median inlier ratio of 0."));
+    CHECK_THAT(c.reason, Catch::Contains("weak ones agree): neither confirmed nor refuted"));
     CHECK_THAT(c.reason, Catch::Contains("overlap too little for HOTS to judge the extrinsic"));
-    CHECK_THAT(c.reason, Catch::Contains("registered with enough overlap: neither confirmed"));
     CHECK_THAT(c.reason, !Catch::Contains("likely wrong"));
   }
   SECTION("links kept, none agreeing: likely wrong") {
@@ -290,6 +303,8 @@ TEST_CASE("an unconfirmed extrinsic says whether its links refuted it or none re
     const auto c = unconfirmed(o);
     CHECK(c.hots->statistics.cross_links > 0);
     CHECK(c.hots->statistics.cross_links_agreeing == 0);
+    CHECK(c.hots->statistics.link_verdict == hots::LinkVerdict::kept_links_refute);
+    CHECK(c.hots->statistics.cross_links_converged >= c.hots->statistics.cross_links);
     CHECK_THAT(c.reason, Catch::Contains("too few of the cross links"));
     CHECK_THAT(c.reason, Catch::Contains("likely wrong"));
     CHECK_THAT(c.reason, !Catch::Contains("overlap too little"));

@@ -78,7 +78,7 @@ TEST_CASE("refine improves a disturbed extrinsic on a simulated 64-32 drive", "[
   // refined (the offset it kept, the extrinsic, the poses).
   REQUIRE(r.status == hots::RefineStatus::time_offset_untrusted);
   // The offset is checked after the cross links: a right start keeps enough of them.
-  CHECK(hots::hots_detail::links_confirm(r.statistics, options));
+  CHECK(r.statistics.link_verdict == hots::LinkVerdict::kept_links_agree);
   CHECK(r.statistics.sequence.time_offset_checked);
   CHECK(r.statistics.sequence.time_observability < options.sequence.min_time_observability);
   const auto e0 = ulc::pose_error(C_gt, C0);
@@ -316,6 +316,63 @@ TEST_CASE("a link records how far its registration moved from the start", "[hots
   CHECK(e.translation_m < 0.01);
   CHECK(link->moved_rad / hots_test::kDeg == Approx(2.0).margin(0.05));
   CHECK(link->moved_m == Approx(0.30).margin(0.01));
+}
+
+TEST_CASE("a registration reports its overlap whether or not the link is kept", "[hots][links]") {
+  // One frame registered to itself from a 1 deg, 10 cm start: it converges with nearly every
+  // point an inlier; with the keep rule out of reach the link is dropped, its overlap still told.
+  const auto& frame = drive().data.lidars[0].frames.at(0);
+  const std::vector<ulc::Vec3<float>> cloud(frame.points.begin(), frame.points.end());
+  ulc::Isometry3d start = ulc::Isometry3d::Identity();
+  start.linear() = Eigen::AngleAxisd(1.0 * hots_test::kDeg, ulc::Vec3d::UnitZ()).toRotationMatrix();
+  start.translation() = ulc::Vec3d(0.1, 0.0, 0.0);
+  hots::CrossLinkOptions options;
+  options.min_inlier_ratio = 1.1;
+  const auto stages = ulc::coarse_to_fine_stages(options.gate);
+  const auto r = hots::register_link(cloud, cloud, start, options, stages);
+  INFO("inlier ratio " << r.inlier_ratio);
+  CHECK(r.converged);
+  CHECK(r.inlier_ratio > 0.9);
+  CHECK(r.inlier_ratio <= 1.0);
+  CHECK_FALSE(r.kept(options));
+  CHECK_FALSE(hots::register_clouds(cloud, cloud, start, options, stages));
+  CHECK(hots::agrees(r.link, options));
+  options.min_inlier_ratio = 0.3;
+  CHECK(r.kept(options));
+}
+
+TEST_CASE("the trust rule: kept links judge; none kept, nothing to judge by", "[hots][links]") {
+  using hots::LinkVerdict;
+  const hots::RefineOptions options;  // max(3, 3 % of the attempted) agreeing
+  const auto verdict = [&](std::size_t kept, std::size_t agreeing, std::size_t weak_agreeing) {
+    hots::RefineStatistics st;
+    st.cross_links_attempted = 200;
+    st.cross_links = kept;
+    st.cross_links_agreeing = agreeing;
+    st.cross_links_weak = st.cross_links_weak_agreeing = weak_agreeing;
+    return hots::hots_detail::judge_links(st, options);
+  };
+  CHECK(verdict(10, 6, 0) == LinkVerdict::kept_links_agree);  // max(3, 6) = 6
+  CHECK(verdict(10, 5, 0) == LinkVerdict::kept_links_refute);
+  CHECK(verdict(1, 0, 150) == LinkVerdict::kept_links_refute);  // weak links never judge
+  CHECK(verdict(0, 0, 150) == LinkVerdict::too_little_overlap);
+  hots::RefineStatistics none;
+  CHECK(hots::hots_detail::judge_links(none, options) == LinkVerdict::not_judged);
+  hots::RefineOptions off = options;
+  off.min_cross_link_ratio = 0.0;
+  hots::RefineStatistics refuting;
+  refuting.cross_links_attempted = refuting.cross_links = 90;
+  CHECK(hots::hots_detail::judge_links(refuting, off) == LinkVerdict::not_judged);
+  CHECK(hots::hots_detail::judge_links(refuting, options) == LinkVerdict::kept_links_refute);
+  CHECK(hots::confirms(LinkVerdict::not_judged));
+  CHECK_FALSE(hots::confirms(LinkVerdict::too_little_overlap));
+}
+
+TEST_CASE("the median of an odd and an even count", "[hots][links]") {
+  using hots::cross_link_detail::median;
+  CHECK(median({}) == 0.0);
+  CHECK(median({0.4, 0.1, 0.3}) == 0.3);
+  CHECK(median({0.4, 0.1, 0.3, 0.2}) == Approx(0.25));
 }
 
 TEST_CASE("the boundary crop keeps the points within the radius, or all of them",

@@ -15,6 +15,7 @@
 #include <cmath>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "pipeline/pair_calibration.hpp"
 #include "ulc/core/angles.hpp"
@@ -197,6 +198,19 @@ inline std::string hots_status_text(const HotsReport& h) {
   }
 }
 
+/// Each cross-link registration HOTS tried, one row each under named columns (a result file
+/// holds tens to a few hundred).
+inline Json cross_link_records_to_json(const std::vector<hots::CrossLinkRecord>& records) {
+  Json rows = Json::array();
+  for (const auto& r : records)
+    rows.push_back(Json::array(
+        {r.layer, r.converged ? 1 : 0, r.inlier_ratio, r.moved_rad * kDegPerRad, r.moved_m}));
+  Json j = Json::object();
+  j["columns"] = Json::array({"layer", "converged", "inlier_ratio", "moved_deg", "moved_m"});
+  j["rows"] = std::move(rows);
+  return j;
+}
+
 /// stages.hots: the odometry that fed it, the graph's and the time synchronisation's statistics
 /// and the spread-against-offset curve.
 inline Json hots_to_json(const HotsReport& h) {
@@ -224,6 +238,12 @@ inline Json hots_to_json(const HotsReport& h) {
   j["cross_links"] = s.cross_links;
   j["cross_links_attempted"] = s.cross_links_attempted;
   j["cross_links_agreeing"] = s.cross_links_agreeing;
+  j["cross_links_converged"] = s.cross_links_converged;
+  j["cross_links_weak"] = s.cross_links_weak;
+  j["cross_links_weak_agreeing"] = s.cross_links_weak_agreeing;
+  j["link_verdict"] = hots::to_string(s.link_verdict);
+  j["cross_link_inlier_ratio_median"] = s.cross_link_inlier_ratio_median;
+  j["cross_link_registrations"] = cross_link_records_to_json(s.cross_link_records);
   j["extrinsic_ties"] = s.extrinsic_ties;
   j["boundary_factors"] = s.boundary_factors;
   j["boundary_links"] = s.boundary_links;
