@@ -258,7 +258,7 @@ TEST_CASE("HOTS from the base's own odometry: run once, handed on, the joint one
   CHECK(between.translation_m < 0.01);
 }
 
-TEST_CASE("the cross links confirm, refute, or cannot judge the extrinsic HOTS starts from",
+TEST_CASE("an unconfirmed extrinsic says whether its links refuted it or none registered",
           "[calibrate][hots][status]") {
   const auto& d = drive_64_32_hots();
   const auto& a = d.lidars[0];
