@@ -51,10 +51,15 @@ def simulate(ulc, scenario, seed, seconds, folder):
 
 
 def hots_alone(ulc, folder, pair, initial, out):
-    subprocess.run([ulc, "calibrate", "--base", os.path.join(folder, pair["base"]), "--target",
-                    os.path.join(folder, pair["target"]), "--synced-clocks", "--stages", "hots",
-                    "--threads", "2", "--initial", initial, "--output", out, "--quiet"],
-                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    if os.path.exists(out):
+        os.remove(out)  # a stale file from an earlier run must not stand in for this one
+    run = subprocess.run([ulc, "calibrate", "--base", os.path.join(folder, pair["base"]),
+                          "--target", os.path.join(folder, pair["target"]), "--synced-clocks",
+                          "--stages", "hots", "--threads", "2", "--initial", initial, "--output",
+                          out, "--quiet"], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                         text=True)
+    if run.returncode not in (0, 1) or not os.path.exists(out):  # 1: ran, and HOTS refused
+        sys.exit("ulc calibrate on %s failed (exit %d): %s" % (folder, run.returncode, run.stderr))
     with open(out) as f:
         entry = json.load(f)["results"][0]
     return entry["status"], entry["stages"]["hots"]["cross_link_registrations"]["rows"]
