@@ -44,6 +44,7 @@
 #include "hots/options.hpp"
 #include "hots/refine_statistics.hpp"
 #include "ulc/core/batched_for.hpp"
+#include "ulc/core/median.hpp"
 #include "ulc/core/nearest_time.hpp"
 #include "ulc/core/point_to_plane.hpp"
 #include "ulc/core/registration_target.hpp"
@@ -129,16 +130,6 @@ inline void tally(const LinkRegistration& r, const CrossLinkOptions& options, Cr
     ++stats.weak;
     stats.weak_agreeing += agreeing;
   }
-}
-
-/// The median of `values` (the mean of the middle two for an even count); 0 when empty.
-inline double median(std::vector<double> values) {
-  if (values.empty()) return 0.0;
-  const std::size_t mid = values.size() / 2;
-  std::nth_element(values.begin(), values.begin() + mid, values.end());
-  const double upper = values[mid];
-  if (values.size() % 2 == 1) return upper;
-  return 0.5 * (upper + *std::max_element(values.begin(), values.begin() + mid));
 }
 
 }  // namespace cross_link_detail
@@ -240,7 +231,7 @@ std::vector<CrossLink> cross_links(
       if (r.kept(options)) links.push_back(r.link);
     }
   }
-  counts.inlier_ratio_median = d::median(std::move(ratios));
+  counts.inlier_ratio_median = ulc::median(std::move(ratios));
   if (stats) *stats = counts;
   return links;
 }

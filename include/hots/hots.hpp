@@ -53,7 +53,7 @@
 //     from one call to the next (prepared_a), and is used when it was built from the same poses
 //     bit for bit: a rig's targets on the base's own odometry share it (pipeline/rig.hpp).
 //   - With time synchronisation on, the whole-sequence step checks that the drive pins the
-//     clock offset down (sequence_extrinsic.hpp, check_time_offset); when it does not, the
+//     clock offset down (sequence_offset.hpp, check_time_offset); when it does not, the
 //     status is time_offset_untrusted and reason says why: the extrinsic absorbs v * (the
 //     offset's error), so the result cannot be trusted. A caller who knows the offset turns
 //     the synchronisation off and passes it as time_offset_s.

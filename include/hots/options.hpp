@@ -140,7 +140,7 @@ struct SequenceExtrinsicOptions {
   std::size_t time_cluster_frames = 10;  ///< consecutive target frames sharing their errors
   double derivative_step_s = 1e-3;       ///< central difference of the trajectory
   double min_condition = 1e-6;           ///< eigen directions (scaled) skipped below this
-  bool check_time_offset = true;         ///< the halves' trust check (header comment)
+  bool check_time_offset = true;         ///< the halves' trust check (sequence_offset.hpp)
   /// s: the halves' offsets, and the kept offset and the whole solve's, must agree this well
   /// (5 ms is 5 cm of translation at 10 m/s).
   double max_time_disagreement_s = 5e-3;

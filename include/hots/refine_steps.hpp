@@ -600,7 +600,7 @@ bool sequence_step(RefineState<S>& s, const RefineOptions& options, RefineResult
     // out by dC/ddt) it still lies 1.0-1.7 cm from the step, which would make sigma 5-9x the
     // error (docs/experiments/graph_move_after_offset.md). The rerun, solved at the step's
     // offset, is then the only sample besides the step's own term for the offset's error
-    // (sequence_extrinsic.hpp, offset_error_term).
+    // (sequence_offset.hpp, offset_error_term).
     const Vec6d moved = st.sequence.time_offset_refined
                             ? Vec6d::Zero()
                             : ulc::se3_log(Isometry3d(graph_answer * result.extrinsic.inverse()));

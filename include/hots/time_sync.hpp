@@ -40,6 +40,7 @@
 
 #include "hots/options.hpp"
 #include "ulc/core/lie.hpp"
+#include "ulc/core/median.hpp"
 #include "ulc/core/rotation_mean.hpp"
 #include "ulc/core/types.hpp"
 
@@ -96,14 +97,6 @@ inline Isometry3d pose_at(const std::vector<double>& times, const std::vector<Is
   const double span = times[j + 1] - times[j];
   const double alpha = span > 0.0 ? (t - times[j]) / span : 0.0;
   return ulc::interpolate(poses[j], poses[j + 1], alpha);
-}
-
-inline double median_period(const std::vector<double>& times) {
-  std::vector<double> d;
-  for (std::size_t i = 1; i < times.size(); ++i) d.push_back(times[i] - times[i - 1]);
-  if (d.empty()) return 0.0;
-  std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2), d.end());
-  return d[d.size() / 2];
 }
 
 struct Problem {
@@ -228,7 +221,7 @@ TimeSyncResult time_sync(const std::vector<double>& times_a,
   for (const auto& T : poses_b)
     if (!T.matrix().allFinite()) return fail(TimeSyncStatus::invalid_input, "a pose is not finite");
 
-  const double width = options.search_periods * d::median_period(times_a);
+  const double width = options.search_periods * ulc::median_step(times_a);
   const double lo = options.centre_s - width, hi = options.centre_s + width;
   d::Problem problem{&times_a, &poses_a, &times_b,
                      &poses_b, {},       options.rotation_scale_m * options.rotation_scale_m};

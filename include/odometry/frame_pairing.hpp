@@ -16,6 +16,8 @@
 #include <limits>
 #include <vector>
 
+#include "ulc/core/median.hpp"
+
 namespace odometry {
 
 struct FramePair {
@@ -33,13 +35,7 @@ inline bool timestamps_usable(const std::vector<double>& t) {
 
 /// The median gap between consecutive timestamps; 0 with fewer than two frames.
 inline double frame_period(const std::vector<double>& t) {
-  if (t.size() < 2) return 0.0;
-  std::vector<double> gaps;
-  gaps.reserve(t.size() - 1);
-  for (std::size_t i = 1; i < t.size(); ++i) gaps.push_back(t[i] - t[i - 1]);
-  const std::size_t m = gaps.size() / 2;
-  std::nth_element(gaps.begin(), gaps.begin() + static_cast<std::ptrdiff_t>(m), gaps.end());
-  return gaps[m];
+  return ulc::median_step(t);
 }
 
 inline std::vector<FramePair> pair_frames(const std::vector<double>& times_a,

@@ -28,6 +28,7 @@
 #include "odometry/odometry.hpp"
 #include "odometry/scan_preparation.hpp"
 #include "odometry/status.hpp"
+#include "ulc/core/median.hpp"
 #include "ulc/core/point_traits.hpp"
 
 namespace odometry {
@@ -55,10 +56,7 @@ inline double median_condition(const OdometryResult& odo) {
   std::vector<double> c;
   for (const OdometryStep& s : odo.steps)
     if (s.registered) c.push_back(s.condition);
-  if (c.empty()) return 0.0;
-  const auto middle = c.begin() + static_cast<std::ptrdiff_t>(c.size() / 2);
-  std::nth_element(c.begin(), middle, c.end());
-  return *middle;
+  return ulc::upper_median(std::move(c));
 }
 
 using ProgressFn = std::function<void(std::size_t done, std::size_t total)>;

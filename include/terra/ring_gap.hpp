@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "ulc/core/angles.hpp"
+#include "ulc/core/median.hpp"
 #include "ulc/core/point_traits.hpp"
 #include "ulc/core/types.hpp"
 
@@ -73,10 +74,7 @@ double ring_gap_deg(const Cloud& frame, const RingGapOptions& o = {}) {
   const std::vector<double> rings =
       ring_centres(elevation_histogram(frame, o), std::max<std::size_t>(o.min_bin_points, 1));
   if (rings.size() < std::max<std::size_t>(o.min_rings, 2)) return 0.0;
-  std::vector<double> spacing;
-  for (std::size_t k = 1; k < rings.size(); ++k) spacing.push_back(rings[k] - rings[k - 1]);
-  std::nth_element(spacing.begin(), spacing.begin() + spacing.size() / 2, spacing.end());
-  return spacing[spacing.size() / 2] * o.bin_deg;
+  return ulc::median_step(rings) * o.bin_deg;
 }
 
 }  // namespace terra

@@ -368,13 +368,6 @@ TEST_CASE("the trust rule: kept links judge; none kept, nothing to judge by", "[
   CHECK_FALSE(hots::confirms(LinkVerdict::too_little_overlap));
 }
 
-TEST_CASE("the median of an odd and an even count", "[hots][links]") {
-  using hots::cross_link_detail::median;
-  CHECK(median({}) == 0.0);
-  CHECK(median({0.4, 0.1, 0.3}) == 0.3);
-  CHECK(median({0.4, 0.1, 0.3, 0.2}) == Approx(0.25));
-}
-
 TEST_CASE("the boundary crop keeps the points within the radius, or all of them",
           "[hots][boundary]") {
   const std::vector<ulc::Vec3<float>> cloud{{0, 0, 0}, {3, 4, 0}, {5.5f, 0, 0}, {-1, -1, -1}};

@@ -28,6 +28,7 @@
 #include <string>
 #include <vector>
 
+#include "ulc/core/median.hpp"
 #include "ulc/core/point_traits.hpp"
 
 namespace ulc {
@@ -96,9 +97,7 @@ inline double sweep_start(const std::vector<double>& u, std::size_t count) {
   std::vector<double> first;
   for (std::size_t i = 0; i < u.size() && first.size() < count; ++i)
     if (!std::isnan(u[i])) first.push_back(u[i]);
-  std::nth_element(first.begin(), first.begin() + static_cast<std::ptrdiff_t>(first.size() / 2),
-                   first.end());
-  return first[first.size() / 2];
+  return upper_median(std::move(first));
 }
 
 }  // namespace sweep_detail

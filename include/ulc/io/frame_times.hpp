@@ -40,6 +40,7 @@
 #include <string>
 #include <vector>
 
+#include "ulc/core/median.hpp"
 #include "ulc/io/io_error.hpp"
 #include "ulc/io/text_parse.hpp"
 
@@ -61,15 +62,6 @@ struct TimeUnit {
 
 inline constexpr TimeUnit kTimeUnits[] = {
     {1.0, "seconds"}, {1e-3, "milliseconds"}, {1e-6, "microseconds"}, {1e-9, "nanoseconds"}};
-
-/// Median of the steps between consecutive times; 0 with fewer than two.
-inline double median_step(const std::vector<double>& times) {
-  if (times.size() < 2) return 0.0;
-  std::vector<double> steps;
-  for (std::size_t i = 1; i < times.size(); ++i) steps.push_back(times[i] - times[i - 1]);
-  std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
-  return steps[steps.size() / 2];
-}
 
 /// The unit of increasing frame times (see the top); IoError naming `file` when none fits.
 inline TimeUnit frame_time_unit(const std::vector<double>& times, const std::string& file,
