@@ -1,14 +1,12 @@
 // The steps of hots::refine (hots.hpp, whose header comment holds the conventions), each a
 // function on the state the call builds: inputs checked, frames prepared, hierarchies, cross
 // links, the pose graph and its passes, the whole-sequence step, the poses out.
+// The state: refine_state.hpp; the inputs and frames: refine_prepare.hpp; the pose graph:
+// refine_graph.hpp.
 #pragma once
 
-#include <algorithm>
 #include <chrono>
-#include <cmath>
 #include <cstddef>
-#include <memory>
-#include <optional>
 #include <vector>
 
 #include "hots/boundary_bridges.hpp"
@@ -16,41 +14,16 @@
 #include "hots/cross_links.hpp"
 #include "hots/hierarchy.hpp"
 #include "hots/options.hpp"
-#include "hots/pose_graph.hpp"
+#include "hots/refine_graph.hpp"
+#include "hots/refine_prepare.hpp"
+#include "hots/refine_state.hpp"
 #include "hots/refine_statistics.hpp"
 #include "hots/sequence_extrinsic.hpp"
 #include "hots/sparse_lm.hpp"
 #include "hots/time_sync.hpp"
-#include "ulc/core/batched_for.hpp"
-#include "ulc/core/deskew.hpp"
 #include "ulc/core/mahalanobis.hpp"
-#include "ulc/core/point_traits.hpp"
-#include "ulc/core/voxel_downsample.hpp"
 
 namespace hots {
-
-/// What refine builds for one LiDAR from its own frames, timestamps and odometry alone: the frames
-/// deskewed and thinned, their sweeps, the hierarchy and its bridges, and the poses the hierarchy
-/// gave. Nothing after build_hierarchies changes it, so base LiDAR a's can serve another refine
-/// call with the same frames, odometry poses and options (refine's prepared_a).
-template <typename S>
-struct PreparedLidar {
-  std::vector<Isometry3d> built_from;  ///< the odometry poses it was built from
-  std::vector<Isometry3d> world;       ///< the odometry's, then the hierarchy's (map a)
-  std::vector<std::vector<ulc::Vec3<S>>> frames;
-  std::vector<SweepParts<S>> sweeps;  ///< when hierarchy.sweep_parts > 1 (views into frames)
-  HierarchyResult<S> hierarchy;
-  BoundaryBridges bridges;
-};
-
-/// `prepared` was built from exactly these odometry poses (bit for bit).
-template <typename S>
-bool built_from(const PreparedLidar<S>& prepared, const std::vector<Isometry3d>& poses) {
-  if (prepared.built_from.size() != poses.size()) return false;
-  for (std::size_t i = 0; i < poses.size(); ++i)
-    if (!(prepared.built_from[i].matrix().array() == poses[i].matrix().array()).all()) return false;
-  return true;
-}
 
 namespace hots_detail {
 
@@ -83,236 +56,6 @@ inline const char* unconfirmed_reason(LinkVerdict verdict) {
          "enough of b's points on a's surfaces: the two LiDARs' views overlap too little for "
          "HOTS to judge the extrinsic, right or wrong (statistics: cross_links of "
          "cross_links_attempted)";
-}
-
-/// Seconds since `start`, and `start` moved to now: consecutive phases of one run.
-inline double lap(std::chrono::steady_clock::time_point& start) {
-  const auto now = std::chrono::steady_clock::now();
-  const double s = std::chrono::duration<double>(now - start).count();
-  start = now;
-  return s;
-}
-
-/// Orders a frame's thinned points by part of its sweep (stably: `parts` equal parts of the
-/// sweep's duration by each point's time, `times` seconds into the sweep) and returns the parts
-/// as views into them, each with its points' mean fraction of the sweep. Without times the frame
-/// is one part at fraction 0. The views are the parts without a second copy of the frame.
-template <typename S>
-SweepParts<S> order_by_part(std::vector<ulc::Vec3<S>>& points, const std::vector<double>* times,
-                            const std::pair<Isometry3d, double>& motion, int parts) {
-  const std::size_t n = times ? static_cast<std::size_t>(std::max(parts, 1)) : 1;
-  std::vector<std::size_t> part(points.size(), 0), count(n, 0);
-  std::vector<double> fraction_sum(n, 0.0);
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    const double f = times ? (*times)[i] / motion.second : 0.0;
-    const int j = std::clamp(static_cast<int>(std::floor(f * static_cast<double>(n))), 0,
-                             static_cast<int>(n) - 1);
-    part[i] = static_cast<std::size_t>(j);
-    ++count[part[i]];
-    fraction_sum[part[i]] += f;
-  }
-  std::vector<std::size_t> start(n, 0);
-  for (std::size_t j = 1; j < n; ++j) start[j] = start[j - 1] + count[j - 1];
-  std::vector<ulc::Vec3<S>> ordered(points.size());
-  std::vector<std::size_t> next = start;
-  for (std::size_t i = 0; i < points.size(); ++i) ordered[next[part[i]]++] = points[i];
-  points.swap(ordered);
-  SweepParts<S> sp;
-  sp.deskew = motion.first;
-  for (std::size_t j = 0; j < n; ++j) {
-    sp.parts.emplace_back(points.data() + start[j], count[j]);
-    sp.fraction.push_back(count[j] ? fraction_sum[j] / static_cast<double>(count[j]) : 0.0);
-  }
-  return sp;
-}
-
-/// Deskewed and downsampled copies of every stride-th frame (the others stay empty);
-/// sweep(k) gives frame k's motion over its sweep and the sweep's duration. With `sweeps`, each
-/// frame's kept points are also ordered by part of the sweep and `sweeps` holds the parts
-/// (order_by_part; a frame without point times is one part at fraction 0): views into the
-/// returned frames, valid while those vectors are neither copied from nor reallocated.
-/// progress (optional) gets the fraction of frames done, every few frames.
-template <typename S, class Frames, class Sweep>
-std::vector<std::vector<ulc::Vec3<S>>> prepare_frames(const Frames& frames, const Sweep& sweep,
-                                                      double voxel, std::size_t stride = 1,
-                                                      std::vector<SweepParts<S>>* sweeps = nullptr,
-                                                      int parts = 1,
-                                                      const ulc::StepProgress& progress = {}) {
-  std::vector<std::vector<ulc::Vec3<S>>> out(frames.size());
-  if (sweeps) sweeps->assign(frames.size(), SweepParts<S>{});
-  stride = std::max<std::size_t>(stride, 1);
-  ulc::parallel_for_in_batches(
-      frames.size(), ulc::default_batch_size(),
-      [&](std::size_t k) {
-        if (k % stride != 0) return;
-        const std::pair<Isometry3d, double> motion = sweep(k);
-        const auto& frame = frames[k];  // once: a FrameSource reads it on each access
-        auto deskewed = ulc::deskew(frame, motion.first, motion.second);
-        const bool timed = sweeps && ulc::traits::has_time(frame) && motion.second > 0.0;
-        if (timed) {
-          deskewed.times.resize(deskewed.points.size());
-          for (std::size_t i = 0; i < deskewed.points.size(); ++i)
-            deskewed.times[i] = ulc::traits::time(frame, i);
-        }
-        const auto down = ulc::voxel_downsample(deskewed, voxel);
-        const auto& cloud = down.ok() ? down.cloud : deskewed;
-        out[k].reserve(cloud.points.size());
-        for (const auto& p : cloud.points) out[k].push_back(p.template cast<S>());
-        if (!sweeps) return;
-        const bool split = timed && cloud.times.size() == out[k].size();
-        (*sweeps)[k] = order_by_part(out[k], split ? &cloud.times : nullptr, motion, parts);
-      },
-      [&](std::size_t done) {
-        if (progress) progress(static_cast<double>(done) / static_cast<double>(frames.size()));
-      });
-  return out;
-}
-
-/// Constant velocity from a LiDAR's own poses: the motion to the next frame.
-inline std::pair<Isometry3d, double> own_sweep(const std::vector<double>& times,
-                                               const std::vector<Isometry3d>& poses,
-                                               std::size_t k) {
-  const std::size_t j = k + 1 < times.size() ? k : k - 1;
-  return {poses[j].inverse() * poses[j + 1], times[j + 1] - times[j]};
-}
-
-/// Every frame deskewed with its LiDAR's own poses (own_sweep).
-template <typename S, class Frames>
-std::vector<std::vector<ulc::Vec3<S>>> prepare_frames(
-    const Frames& frames, const std::vector<double>& times, const std::vector<Isometry3d>& poses,
-    double voxel, std::vector<SweepParts<S>>* sweeps = nullptr, int parts = 1,
-    const ulc::StepProgress& progress = {}) {
-  return prepare_frames<S>(
-      frames, [&](std::size_t k) { return own_sweep(times, poses, k); }, voxel, 1, sweeps, parts,
-      progress);
-}
-
-/// The a frame nearest to t (a's clock) and a's motion from it to t (interpolated or
-/// extrapolated with the neighbouring frame).
-inline std::pair<std::size_t, Isometry3d> a_at(const std::vector<double>& times,
-                                               const std::vector<Isometry3d>& poses, double t) {
-  auto it = std::lower_bound(times.begin(), times.end(), t);
-  std::size_t k = static_cast<std::size_t>(it - times.begin());
-  if (k == times.size() || (k > 0 && t - times[k - 1] <= times[k] - t)) --k;
-  const std::size_t j = t >= times[k] ? std::min(k, times.size() - 2) : (k > 0 ? k - 1 : 0);
-  const double span = times[j + 1] - times[j];
-  const double alpha = span > 0.0 ? (t - times[j]) / span : 0.0;
-  const Isometry3d at_t = ulc::interpolate(poses[j], poses[j + 1], alpha);
-  return {k, poses[k].inverse() * at_t};
-}
-
-inline bool usable_times(const std::vector<double>& t) {
-  if (t.size() < 2) return false;
-  for (std::size_t i = 0; i < t.size(); ++i) {
-    if (!std::isfinite(t[i])) return false;
-    if (i > 0 && !(t[i] > t[i - 1])) return false;
-  }
-  return true;
-}
-
-/// Why refine cannot run on these sequences; nullptr when it can.
-template <class SeqA, class SeqB>
-const char* input_problem(const SeqA& a, const SeqB& b, const Isometry3d& extrinsic,
-                          const RefineOptions& options) {
-  if (a.frames.size() != a.times.size() || a.frames.size() != a.poses.size() ||
-      b.frames.size() != b.times.size() || b.frames.size() != b.poses.size())
-    return "frame, time and pose counts differ";
-  if (!usable_times(a.times) || !usable_times(b.times))
-    return "need two or more strictly increasing times";
-  if (!extrinsic.matrix().allFinite()) return "extrinsic not finite";
-  for (const auto* list : {&a.poses, &b.poses})
-    for (const Isometry3d& T : *list)
-      if (!T.matrix().allFinite()) return "a pose is not finite";
-  if (!(options.frame_voxel > 0.0) || options.passes < 1 || !(options.extrinsic_sigma_m > 0.0) ||
-      !(options.extrinsic_sigma_rad > 0.0))
-    return "bad options";
-  return nullptr;
-}
-
-/// One LiDAR as refine works on it: its timestamps and odometry, what was prepared from them
-/// (held by `prepared`, shared when it was reused), the registered top-layer boundaries and its
-/// place in the graph.
-template <typename S>
-struct RefineLidar {
-  RefineLidar(const std::vector<double>& t, const std::vector<Isometry3d>& poses,
-              std::shared_ptr<PreparedLidar<S>> p)
-      : times(t),
-        odometry(poses),
-        reused(p != nullptr),
-        prepared(p ? std::move(p) : std::make_shared<PreparedLidar<S>>()),
-        world(prepared->world),
-        frames(prepared->frames),
-        sweeps(prepared->sweeps),
-        hierarchy(prepared->hierarchy),
-        bridges(prepared->bridges) {}
-
-  const std::vector<double>& times;
-  const std::vector<Isometry3d>& odometry;  ///< the input poses, in the LiDAR's own map
-  const bool reused;                        ///< prepared came built: nothing to prepare or build
-  const std::shared_ptr<PreparedLidar<S>> prepared;
-  std::vector<Isometry3d>& world;
-  std::vector<std::vector<ulc::Vec3<S>>>& frames;
-  std::vector<SweepParts<S>>& sweeps;
-  HierarchyResult<S>& hierarchy;
-  BoundaryBridges& bridges;
-  std::vector<std::optional<CrossLink>> boundaries;  ///< top-layer boundaries registered
-  std::size_t first_var = 0;                         ///< its first pose in the graph
-};
-
-/// Everything one refine call builds, step after step.
-template <typename S>
-struct RefineState {
-  /// prepared_a: a's preparation to reuse (built from seq_a's poses), or null.
-  template <class SeqA, class SeqB>
-  RefineState(const SeqA& seq_a, const SeqB& seq_b, std::shared_ptr<PreparedLidar<S>> prepared_a)
-      : a(seq_a.times, seq_a.poses, std::move(prepared_a)), b(seq_b.times, seq_b.poses, nullptr) {}
-
-  RefineLidar<S> a, b;
-  Isometry3d start = Isometry3d::Identity();  ///< the extrinsic refine started from
-  Isometry3d mapa_mapb = Isometry3d::Identity();
-  std::vector<CrossLink> links;
-  PoseGraph graph;
-  std::size_t extrinsic_var = 0;
-  std::size_t first_tie = 0;  ///< the ties are the graph's last factors
-  std::chrono::steady_clock::time_point clock = std::chrono::steady_clock::now();
-};
-
-/// T_mapa_mapb = P_a(t_a0) C P_b(t_a0)^-1, b's pose interpolated to a's first instant.
-template <typename S>
-Isometry3d map_b_in_map_a(const RefineLidar<S>& a, const RefineLidar<S>& b,
-                          const Isometry3d& extrinsic, double time_offset_s) {
-  const double t0 = a.times.front() - time_offset_s;  // b's clock
-  const Isometry3d b_at_t0 = time_sync_detail::pose_at(
-      b.times, b.odometry, std::clamp(t0, b.times.front(), b.times.back()));
-  return a.odometry.front() * extrinsic * b_at_t0.inverse();
-}
-
-/// a's share of work that grows with the frames: its frames over both LiDARs'.
-inline double share_of_a(std::size_t frames_a, std::size_t frames_b) {
-  const double a = static_cast<double>(frames_a);
-  return a / std::max(a + static_cast<double>(frames_b), 1.0);
-}
-
-/// Both LiDARs' frames deskewed with their own odometry and thinned (statistics: prepare);
-/// progress gets the fraction done, a's frames first.
-template <typename S, class SeqA, class SeqB>
-void prepare_lidars(const SeqA& seq_a, const SeqB& seq_b, RefineState<S>& s,
-                    const RefineOptions& options, RefineStatistics& st,
-                    const ulc::StepProgress& progress) {
-  const int parts = options.hierarchy.sweep_parts;
-  const double share_a = s.a.reused ? 0.0 : share_of_a(s.a.times.size(), s.b.times.size());
-  for (const auto& T : s.b.odometry) s.b.world.push_back(s.mapa_mapb * T);
-  if (!s.a.reused) {
-    s.a.prepared->built_from = s.a.odometry;
-    s.a.world = s.a.odometry;
-    s.a.frames = prepare_frames<S>(seq_a.frames, s.a.times, s.a.odometry, options.frame_voxel,
-                                   parts > 1 ? &s.a.sweeps : nullptr, parts,
-                                   ulc::progress_within(progress, 0.0, share_a));
-  }
-  s.b.frames = prepare_frames<S>(seq_b.frames, s.b.times, s.b.odometry, options.frame_voxel,
-                                 parts > 1 ? &s.b.sweeps : nullptr, parts,
-                                 ulc::progress_within(progress, share_a, 1.0));
-  st.prepare_seconds = lap(s.clock);
 }
 
 /// Each LiDAR's hierarchy of windows (hierarchy.hpp) and bridges across its top-layer
@@ -368,121 +111,6 @@ bool link_lidars(RefineState<S>& s, double time_offset_s, const RefineOptions& o
                                      options.boundary_radius_m, &l->bridges.bridged);
   st.links_seconds = lap(s.clock);
   return true;
-}
-
-/// Factor kinds of the graph (PoseFactor::kind), for its statistics.
-enum FactorKind : int { ba_factor = 0, link_factor = 1, tie_factor = 2, boundary_factor = 3 };
-
-inline void add_relative(PoseGraph& graph, std::size_t from, std::size_t to, const Isometry3d& Z,
-                         const Mat6d& information, double huber, FactorKind kind) {
-  PoseFactor f;
-  f.from = from;
-  f.to = to;
-  f.measured = Z;
-  f.sqrt_information = sqrt_information(information);
-  f.huber = huber;
-  f.kind = kind;
-  graph.add_factor(f);
-}
-
-/// A factor across each boundary between two top-layer submaps that no window spans: the
-/// bridge's BA factors when it has one (already in), else the registered boundary, else the
-/// odometry's step across it (when boundary_sigma_* are set).
-template <typename S>
-void add_boundaries(PoseGraph& graph, const RefineLidar<S>& l, const RefineOptions& options,
-                    RefineStatistics& st) {
-  if (l.hierarchy.members.empty()) return;
-  const bool odometry_boundaries =
-      options.boundary_sigma_m > 0.0 && options.boundary_sigma_rad > 0.0;
-  const auto& top = l.hierarchy.members.back();
-  for (std::size_t m = 0; m + 1 < top.size(); ++m) {
-    if (m < l.bridges.bridged.size() && l.bridges.bridged[m]) {
-      ++st.boundary_bridges;
-      continue;
-    }
-    if (m < l.boundaries.size() && l.boundaries[m]) {
-      const CrossLink& b = *l.boundaries[m];
-      add_relative(graph, l.first_var + b.frame_a, l.first_var + b.frame_b, b.measured,
-                   b.information, options.link_huber, boundary_factor);
-      ++st.boundary_links;
-    } else if (odometry_boundaries) {
-      const std::size_t from = top[m].end - 1, to = top[m + 1].begin;
-      const Mat6d sqrt_info =
-          isotropic_sqrt_information(options.boundary_sigma_m, options.boundary_sigma_rad);
-      add_relative(graph, l.first_var + from, l.first_var + to,
-                   l.odometry[from].inverse() * l.odometry[to],
-                   Mat6d(sqrt_info.transpose() * sqrt_info), 0.0, boundary_factor);
-    } else {
-      continue;
-    }
-    ++st.boundary_factors;
-  }
-}
-
-/// The pose graph: a variable per frame (a's first is the gauge) and one for C; the windows'
-/// and bridges' BA factors, the cross links and the boundaries. The ties come later (set_ties).
-template <typename S>
-void build_graph(RefineState<S>& s, const Isometry3d& extrinsic, const RefineOptions& options,
-                 RefineStatistics& st) {
-  PoseGraph& graph = s.graph;
-  s.b.first_var = s.a.world.size();
-  for (std::size_t i = 0; i < s.a.world.size(); ++i) graph.add_variable(s.a.world[i], i == 0);
-  for (const Isometry3d& T : s.b.world) graph.add_variable(T);
-  s.extrinsic_var = graph.add_variable(extrinsic);
-  for (const RefineLidar<S>* l : {&s.a, &s.b}) {
-    for (const auto& f : l->hierarchy.factors)
-      add_relative(graph, l->first_var + f.from, l->first_var + f.to, f.measured, f.information,
-                   0.0, ba_factor);
-  }
-  for (const RefineLidar<S>* l : {&s.a, &s.b}) {
-    for (const auto& f : l->bridges.factors)
-      add_relative(graph, l->first_var + f.from, l->first_var + f.to, f.measured, f.information,
-                   options.bridge_huber, ba_factor);
-  }
-  st.ba_factors = s.a.hierarchy.factors.size() + s.b.hierarchy.factors.size() +
-                  s.a.bridges.factors.size() + s.b.bridges.factors.size();
-  for (const auto& l : s.links)
-    add_relative(graph, l.frame_a, s.b.first_var + l.frame_b, l.measured, l.information,
-                 options.link_huber, link_factor);
-  add_boundaries(graph, s.a, options, st);
-  add_boundaries(graph, s.b, options, st);
-  s.first_tie = graph.factors.size();
-}
-
-/// The extrinsic ties at clock offset `offset`, replacing the previous ones: for every b frame
-/// whose instant falls inside a's span, r = log((T_a L)^-1 T_b C^-1), with L a's motion from
-/// its nearest frame to that instant on the current poses.
-template <typename S>
-void set_ties(RefineState<S>& s, double offset, const RefineOptions& options,
-              RefineStatistics& st) {
-  PoseGraph& graph = s.graph;
-  graph.factors.resize(s.first_tie);
-  const Mat6d tie_sqrt =
-      isotropic_sqrt_information(options.extrinsic_sigma_m, options.extrinsic_sigma_rad);
-  const std::vector<double>& ta = s.a.times;
-  const std::vector<Isometry3d> pa(
-      graph.variables.begin(), graph.variables.begin() + static_cast<std::ptrdiff_t>(ta.size()));
-  for (std::size_t j = 0; j < s.b.times.size(); ++j) {
-    const double t = s.b.times[j] + offset;  // a's clock
-    if (t < ta.front() || t > ta.back()) continue;
-    const auto [i, L] = a_at(ta, pa, t);
-    PoseFactor f;
-    f.from = i;
-    f.from_offset = L;
-    f.to = s.b.first_var + j;
-    f.measured_var = s.extrinsic_var;
-    f.sqrt_information = tie_sqrt;
-    f.kind = tie_factor;
-    graph.add_factor(f);
-  }
-  st.extrinsic_ties = graph.factors.size() - s.first_tie;
-}
-
-/// The graph's poses of one LiDAR.
-template <typename S>
-std::vector<Isometry3d> graph_poses(const RefineState<S>& s, const RefineLidar<S>& l) {
-  const auto first = s.graph.variables.begin() + static_cast<std::ptrdiff_t>(l.first_var);
-  return std::vector<Isometry3d>(first, first + static_cast<std::ptrdiff_t>(l.world.size()));
 }
 
 /// The time synchronisation on the graph's poses (time_sync.hpp); its extrinsic becomes C's

@@ -30,7 +30,7 @@ struct OdometryResult;  // odometry/run_odometry.hpp
 }  // namespace odometry
 namespace hots {
 template <typename S>
-struct PreparedLidar;  // hots/refine_steps.hpp
+struct PreparedLidar;  // hots/refine_state.hpp
 }  // namespace hots
 
 namespace ulc {

@@ -1,11 +1,11 @@
-// A frame's sweep parts (hots/refine_steps.hpp, order_by_part): views into the frame's own
+// A frame's sweep parts (hots/refine_prepare.hpp, order_by_part): views into the frame's own
 // points, ordered part after part, so that the parts are not a second copy of the frame.
 #include <catch2/catch.hpp>
 #include <cstddef>
 #include <random>
 #include <vector>
 
-#include "hots/refine_steps.hpp"
+#include "hots/refine_prepare.hpp"
 
 namespace sweep_parts_test {
 

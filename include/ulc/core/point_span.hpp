@@ -1,6 +1,6 @@
 // A view of consecutive points of a std::vector<Vec3<S>> (no copy): a cloud for every stage
 // that reads clouds through CloudTraits. HOTS's sweep parts are such views into their frame's
-// thinned points, which prepare_frames orders by part (hots/refine_steps.hpp), so that the
+// thinned points, which prepare_frames orders by part (hots/refine_prepare.hpp), so that the
 // parts are not a second copy of the frames (docs/BENCHMARKS.md, "Long drives": memory).
 //
 // Conventions this header owns:
