@@ -31,6 +31,7 @@
 
 #include "ulc/bags/file_reader.hpp"
 #include "ulc/bags/message_source.hpp"
+#include "ulc/bags/message_span.hpp"
 #include "ulc/bags/ros1/bag_header.hpp"
 #include "ulc/bags/ros1/contents.hpp"
 #include "ulc/bags/ros1/cursor.hpp"
@@ -110,10 +111,11 @@ class Ros1Bag : public MessageSource {
 
   static void add_counts(TopicInfo& t, const ros1::Connection& c) {
     ++t.connections;
-    if (c.count == 0) return;
-    t.first_time_ns = t.message_count == 0 ? c.first_ns : std::min(t.first_time_ns, c.first_ns);
-    t.last_time_ns = t.message_count == 0 ? c.last_ns : std::max(t.last_time_ns, c.last_ns);
-    t.message_count += c.count;
+    MessageSpan span{t.message_count, t.first_time_ns, t.last_time_ns};
+    span.merge(c.messages);
+    t.message_count = span.count;
+    t.first_time_ns = span.first_ns;
+    t.last_time_ns = span.last_ns;
   }
 
   FileReader file_;

@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "ulc/bags/limits.hpp"
+#include "ulc/bags/message_span.hpp"
 #include "ulc/bags/rosbag2_sqlite.hpp"
 #include "ulc/io/io_error.hpp"
 
@@ -118,16 +119,7 @@ class Rosbag2SqliteWriter {
 
  private:
   /// Message count and time span of a topic or a file.
-  struct Stats {
-    std::uint64_t count = 0;
-    std::int64_t first = 0;
-    std::int64_t last = 0;
-    void add(std::int64_t t) {
-      first = count == 0 ? t : std::min(first, t);
-      last = count == 0 ? t : std::max(last, t);
-      ++count;
-    }
-  };
+  using Stats = MessageSpan;
   struct Topic {
     std::string name, type, format;
     Stats stats;
@@ -235,7 +227,7 @@ class Rosbag2SqliteWriter {
   /// rosbag2's metadata.yaml (version 5: per-file details under `files`).
   void write_metadata() const {
     Stats all;
-    for (const auto& f : done_) merge(all, f.stats);
+    for (const auto& f : done_) all.merge(f.stats);
     YAML::Emitter out;
     out << YAML::BeginMap << YAML::Key << "rosbag2_bagfile_information" << YAML::Value
         << YAML::BeginMap;
@@ -254,19 +246,12 @@ class Rosbag2SqliteWriter {
     save_text(folder_ / "metadata.yaml", std::string(out.c_str()) + "\n");
   }
 
-  static void merge(Stats& into, const Stats& part) {
-    if (part.count == 0) return;
-    into.first = into.count == 0 ? part.first : std::min(into.first, part.first);
-    into.last = into.count == 0 ? part.last : std::max(into.last, part.last);
-    into.count += part.count;
-  }
-
   /// `duration` and `starting_time` of a span (0 and 0 when it holds no message).
   static void emit_span(YAML::Emitter& out, const Stats& s) {
     out << YAML::Key << "duration" << YAML::Value << YAML::BeginMap << YAML::Key << "nanoseconds"
-        << YAML::Value << (s.last - s.first) << YAML::EndMap;
+        << YAML::Value << (s.last_ns - s.first_ns) << YAML::EndMap;
     out << YAML::Key << "starting_time" << YAML::Value << YAML::BeginMap << YAML::Key
-        << "nanoseconds_since_epoch" << YAML::Value << s.first << YAML::EndMap;
+        << "nanoseconds_since_epoch" << YAML::Value << s.first_ns << YAML::EndMap;
   }
 
   void emit_topics(YAML::Emitter& out) const {

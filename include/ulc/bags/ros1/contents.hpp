@@ -13,6 +13,7 @@
 
 #include "ulc/bags/compression.hpp"
 #include "ulc/bags/file_reader.hpp"
+#include "ulc/bags/message_span.hpp"
 #include "ulc/bags/ros1_records.hpp"
 #include "ulc/io/endian.hpp"
 
@@ -25,15 +26,7 @@ struct Connection {
   std::string type;
   std::string md5sum;
   std::size_t topic_index = 0;  ///< into Ros1Bag::topics()
-  std::uint64_t count = 0;
-  std::int64_t first_ns = 0;
-  std::int64_t last_ns = 0;
-
-  void count_message(std::int64_t t) {
-    first_ns = count == 0 ? t : std::min(first_ns, t);
-    last_ns = count == 0 ? t : std::max(last_ns, t);
-    ++count;
-  }
+  MessageSpan messages;
 };
 
 /// A chunk record: where its (compressed) data and the index data records after it lie.

@@ -106,7 +106,7 @@ class IndexReader {
     std::uint64_t n = 0;
     contents_.for_each_index_entry(file_, c, buffer,
                                    [&](std::size_t conn, std::int64_t t, std::uint32_t) {
-                                     contents_.connections[conn].count_message(t);
+                                     contents_.connections[conn].messages.add(t);
                                      ++n;
                                    });
     return n;

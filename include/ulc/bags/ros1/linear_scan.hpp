@@ -71,7 +71,7 @@ class LinearScan {
       if (op == Op::message_data) {
         const std::size_t conn = contents_.connection_index(f.u32("conn"), place, at);
         const std::int64_t t = f.time("time");
-        contents_.connections[conn].count_message(t);
+        contents_.connections[conn].messages.add(t);
         contents_.scanned.push_back(
             {t, chunk, static_cast<std::uint32_t>(at), static_cast<std::uint32_t>(conn)});
       } else if (op == Op::connection) {
