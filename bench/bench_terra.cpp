@@ -124,6 +124,43 @@ void move_target(ulc::sim::ScenarioSpec& spec, const ulc::Vec3d& offset) {
     if (m.name == lp.target) m.T_vehicle_lidar.translation() = base + offset;
 }
 
+/// A scenario's first pair: its spec, the pair and its two LiDARs' indices in spec.lidars.
+struct FirstPair {
+  ulc::sim::ScenarioSpec spec;
+  ulc::sim::LidarPair pair;
+  std::size_t base = 0, target = 0;
+};
+
+/// The named scenario's first pair; nullopt (and `error` set) for an unknown or pairless one.
+std::optional<FirstPair> first_pair(const std::string& name, std::string& error) {
+  auto spec = ulc::sim::scenario(name);
+  if (!spec || spec->pairs.empty()) {
+    error = "unknown scenario '" + name + "'";
+    return std::nullopt;
+  }
+  FirstPair fp{*spec, spec->pairs.front(), 0, 0};
+  for (std::size_t i = 0; i < fp.spec.lidars.size(); ++i) {
+    if (fp.spec.lidars[i].name == fp.pair.base) fp.base = i;
+    if (fp.spec.lidars[i].name == fp.pair.target) fp.target = i;
+  }
+  return fp;
+}
+
+/// The truth of `pair` in a simulation's result; nullptr (and `error` set) when the simulation
+/// failed or gave none.
+const ulc::sim::PairTruth* simulated_truth(const ulc::sim::SimulationResult& result,
+                                           const ulc::sim::LidarPair& pair, const std::string& name,
+                                           std::string& error) {
+  if (!result.ok()) {
+    error = name + ": " + result.reason;
+    return nullptr;
+  }
+  for (const auto& p : result.dataset.pairs)
+    if (p.base == pair.base && p.target == pair.target) return &p;
+  error = name + ": no ground truth for its pair";
+  return nullptr;
+}
+
 /// Frame pairs of a simulated scenario's first pair, `samples` of them spread `spacing_s` apart
 /// along the drive; the target frame nearest in time to each base frame. With `mount_offset`,
 /// the target sits there from the base (move_target).
@@ -131,26 +168,19 @@ std::vector<Pair> simulated_pairs(const std::string& name, std::size_t samples, 
                                   std::uint64_t seed, std::string& error,
                                   const std::optional<ulc::Vec3d>& mount_offset = std::nullopt) {
   std::vector<Pair> out;
-  auto spec = ulc::sim::scenario(name);
-  if (!spec || spec->pairs.empty()) {
-    error = "unknown scenario '" + name + "'";
-    return out;
-  }
-  if (mount_offset) move_target(*spec, *mount_offset);
-  const ulc::sim::LidarPair lp = spec->pairs.front();
+  auto fp = first_pair(name, error);
+  if (!fp) return out;
+  if (mount_offset) move_target(fp->spec, *mount_offset);
+  const ulc::sim::ScenarioSpec& spec = fp->spec;
+  const std::size_t base_index = fp->base, target_index = fp->target;
   ulc::sim::SimulationOptions options;
   options.seed = seed;
   options.seconds = spacing_s * static_cast<double>(samples) + 0.5;
   options.keep_frames = false;
-  std::size_t base_index = 0, target_index = 0;
-  for (std::size_t i = 0; i < spec->lidars.size(); ++i) {
-    if (spec->lidars[i].name == lp.base) base_index = i;
-    if (spec->lidars[i].name == lp.target) target_index = i;
-  }
   // Keep the base frames at the sample times and the target frames.
   std::map<std::size_t, ulc::PointCloud<float>> base_frames, target_frames;
   std::vector<double> base_time, target_time;
-  const double base_rate = spec->lidars[base_index].rate_hz;
+  const double base_rate = spec.lidars[base_index].rate_hz;
   const auto stride = static_cast<std::size_t>(std::max(1.0, std::round(spacing_s * base_rate)));
   const auto sink = [&](const ulc::sim::FrameEvent& e) {
     if (e.lidar == base_index && e.frame % stride == 0) base_frames[e.frame] = e.cloud;
@@ -159,19 +189,10 @@ std::vector<Pair> simulated_pairs(const std::string& name, std::size_t samples, 
     if (e.lidar == target_index) target_frames[e.frame] = e.cloud;
     return true;
   };
-  const auto result = ulc::sim::simulate(*spec, options, sink);
-  if (!result.ok()) {
-    error = name + ": " + result.reason;
-    return out;
-  }
+  const auto result = ulc::sim::simulate(spec, options, sink);
+  const ulc::sim::PairTruth* truth = simulated_truth(result, fp->pair, name, error);
+  if (!truth) return out;
   const auto& ds = result.dataset;
-  const ulc::sim::PairTruth* truth = nullptr;
-  for (const auto& p : ds.pairs)
-    if (p.base == lp.base && p.target == lp.target) truth = &p;
-  if (!truth) {
-    error = name + ": no ground truth for its pair";
-    return out;
-  }
   const auto& bt = ds.lidars[base_index].timestamps;
   const auto& tt = ds.lidars[target_index].timestamps;
   for (const auto& [k, cloud] : base_frames) {
@@ -638,17 +659,9 @@ struct Window {
 std::vector<Window> simulated_windows(const std::string& name, const MapsOptions& mo,
                                       std::string& error) {
   std::vector<Window> out;
-  auto spec = ulc::sim::scenario(name);
-  if (!spec || spec->pairs.empty()) {
-    error = "unknown scenario '" + name + "'";
-    return out;
-  }
-  const ulc::sim::LidarPair lp = spec->pairs.front();
-  std::size_t bi = 0, ti = 0;
-  for (std::size_t i = 0; i < spec->lidars.size(); ++i) {
-    if (spec->lidars[i].name == lp.base) bi = i;
-    if (spec->lidars[i].name == lp.target) ti = i;
-  }
+  const auto fp = first_pair(name, error);
+  if (!fp) return out;
+  const std::size_t bi = fp->base, ti = fp->target;
   ulc::sim::SimulationOptions so;
   so.seed = mo.seed;
   so.decimation = mo.decimation;
@@ -670,19 +683,10 @@ std::vector<Window> simulated_windows(const std::string& name, const MapsOptions
     if (e.lidar == ti && in_window(e.timestamp)) target_frames[e.frame] = e.cloud;
     return true;
   };
-  const auto result = ulc::sim::simulate(*spec, so, sink);
-  if (!result.ok()) {
-    error = name + ": " + result.reason;
-    return out;
-  }
+  const auto result = ulc::sim::simulate(fp->spec, so, sink);
+  const ulc::sim::PairTruth* truth = simulated_truth(result, fp->pair, name, error);
+  if (!truth) return out;
   const auto& ds = result.dataset;
-  const ulc::sim::PairTruth* truth = nullptr;
-  for (const auto& p : ds.pairs)
-    if (p.base == lp.base && p.target == lp.target) truth = &p;
-  if (!truth) {
-    error = name + ": no ground truth for its pair";
-    return out;
-  }
   const auto& bt = ds.lidars[bi].timestamps;
   const auto& tt = ds.lidars[ti].timestamps;
   for (std::size_t s = 0; s < mo.starts; ++s) {
