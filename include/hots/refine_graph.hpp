@@ -12,7 +12,6 @@
 #include "hots/pose_graph.hpp"
 #include "hots/refine_state.hpp"
 #include "hots/refine_statistics.hpp"
-#include "ulc/core/mahalanobis.hpp"
 
 namespace hots {
 

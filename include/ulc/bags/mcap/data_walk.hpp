@@ -20,7 +20,7 @@
 namespace ulc::bags::mcap {
 
 /// Walks a data section into a FileIndex: index.scanned receives the messages it found (their
-/// chunk numbered among the unindexed chunks), unindexed() the chunks it scanned.
+/// chunk numbered among the unindexed chunks), take_unindexed() the chunks it scanned.
 class DataWalk {
  public:
   DataWalk(const FileReader& file, FileIndex& index)
@@ -49,7 +49,7 @@ class DataWalk {
     }
   }
 
-  std::vector<ChunkRef>& unindexed() { return unindexed_; }
+  std::vector<ChunkRef> take_unindexed() { return std::move(unindexed_); }
 
  private:
   [[noreturn]] void cut(std::uint64_t pos, const std::string& what) {

@@ -44,7 +44,7 @@ class IndexBuilder {
           "the data section");
       walk.walk(footer_offset_, /*check_crc=*/true);
     }
-    append_scanned_chunks(walk.unindexed());
+    append_scanned_chunks(walk.take_unindexed());
     TopicTable(file_, index_).build(statistics);
   }
 
@@ -89,7 +89,7 @@ class IndexBuilder {
   }
 
   /// The chunks the walk scanned go after the indexed ones; their entries are renumbered.
-  void append_scanned_chunks(std::vector<ChunkRef>& scanned) {
+  void append_scanned_chunks(std::vector<ChunkRef> scanned) {
     const auto base = static_cast<std::uint32_t>(index_.chunks.size());
     for (Entry& e : index_.scanned)
       if (e.chunk != kLoose) e.chunk += base;

@@ -25,12 +25,6 @@ class SummaryReader {
       : file_(file), index_(index), declare_(index), footer_offset_(footer_offset) {}
 
   std::optional<StatisticsRecord> read(const FooterRecord& footer) {
-    read_summary(footer);
-    return statistics_;
-  }
-
- private:
-  void read_summary(const FooterRecord& footer) {
     const std::uint64_t start = footer.summary_start;
     if (start < kMagicSize || start > footer_offset_)
       file_.fail(footer_offset_, "Footer summary_start " + std::to_string(start) +
@@ -66,8 +60,10 @@ class SummaryReader {
       if (index_.chunks[k].offset == index_.chunks[k - 1].offset)
         file_.fail(start, "two ChunkIndex records describe the chunk at byte " +
                               std::to_string(index_.chunks[k].offset));
+    return statistics_;
   }
 
+ private:
   void summary_record(const RecordHeader& rh, const unsigned char* c, const Place& place,
                       std::uint64_t pos, std::uint64_t data_end) {
     switch (static_cast<Op>(rh.op)) {

@@ -3,7 +3,6 @@
 // by its index data records.
 #pragma once
 
-#include <algorithm>
 #include <cstdint>
 #include <string>
 #include <string_view>
