@@ -78,13 +78,14 @@ ulc::sim::Dataset simulate(const std::string& scenario, std::uint64_t seed, cons
   return ulc::sim::simulate(*spec, o).dataset;
 }
 
-/// ", free space 0.283 (385 judged)" for a parked answer the check judged
-/// (pipeline/free_space.hpp).
+/// ", free space 0.283 (385 judged), through 0.04 (1200 rays)" for a parked answer the check
+/// judged (pipeline/free_space.hpp).
 std::string free_space_note(const ulc::PairCalibration& r) {
   if (!r.jeep || !r.jeep->free_space) return "";
+  const ulc::FreeSpaceVerdict& v = *r.jeep->free_space;
   std::ostringstream s;
-  s << ", free space " << r.jeep->free_space->share() << " (" << r.jeep->free_space->judged
-    << " judged)";
+  s << ", free space " << v.share() << " (" << v.judged << " judged), through " << v.through_share()
+    << " (" << v.rays_judged << " rays)";
   return s.str();
 }
 

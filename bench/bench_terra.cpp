@@ -179,7 +179,6 @@ std::vector<Pair> simulated_pairs(const std::string& name, std::size_t samples, 
   options.keep_frames = false;
   // Keep the base frames at the sample times and the target frames.
   std::map<std::size_t, ulc::PointCloud<float>> base_frames, target_frames;
-  std::vector<double> base_time, target_time;
   const double base_rate = spec.lidars[base_index].rate_hz;
   const auto stride = static_cast<std::size_t>(std::max(1.0, std::round(spacing_s * base_rate)));
   const auto sink = [&](const ulc::sim::FrameEvent& e) {

@@ -175,15 +175,28 @@ std::optional<StageOutcome> jeep_step(const AttemptInputs<FA, FB>& in, Attempt& 
   return std::nullopt;
 }
 
-/// The free-space check's refusal, in words.
+/// The free-space check's refusal, in words; empty when the answer stands (too few judged, or
+/// neither share above its bound).
 inline std::string free_space_refusal(const FreeSpaceVerdict& v, const FreeSpaceOptions& o) {
-  char text[256];
-  std::snprintf(text, sizeof text,
-                "JEEP: its extrinsic puts %.0f %% of the target's judged points (%zu of %zu) where "
-                "the base's rays passed through empty space (at most %.0f %%): a look-alike of the "
-                "scene, not the mount",
-                100.0 * v.share(), v.contradicting, v.judged, 100.0 * o.max_share);
-  return text;
+  char text[320];
+  if (v.judged >= o.min_points && v.share() > o.max_share) {
+    std::snprintf(text, sizeof text,
+                  "JEEP: its extrinsic puts %.0f %% of the target's judged points (%zu of %zu) "
+                  "where the base's rays passed through empty space (at most %.0f %%): a "
+                  "look-alike of the scene, not the mount",
+                  100.0 * v.share(), v.contradicting, v.judged, 100.0 * o.max_share);
+    return text;
+  }
+  if (v.rays_judged >= o.min_points && v.through_share() > o.max_through_share) {
+    std::snprintf(text, sizeof text,
+                  "JEEP: its extrinsic sends %.0f %% of the target's judged rays (%zu of %zu) "
+                  "through surfaces the base saw and the target did not (at most %.0f %%): a "
+                  "look-alike of the scene, not the mount",
+                  100.0 * v.through_share(), v.rays_through, v.rays_judged,
+                  100.0 * o.max_through_share);
+    return text;
+  }
+  return "";
 }
 
 /// A static snapshot's JEEP answer against the free space the base saw (free_space.hpp); an
@@ -198,8 +211,9 @@ std::optional<StageOutcome> free_space_step(const AttemptInputs<FA, FB>& in, Att
   if (at.out.jeep->target_speed_mps * gap_s > 0.5 * o.voxel) return std::nullopt;
   const FreeSpaceVerdict v = free_space_verdict(in.a.frames[0], in.b.frames[0], at.extrinsic, o);
   at.out.jeep->free_space = v;
-  if (v.judged < o.min_points || v.share() <= o.max_share) return std::nullopt;
-  return StageOutcome{CalibrateStatus::jeep_failed, free_space_refusal(v, o), true};
+  std::string why = free_space_refusal(v, o);
+  if (why.empty()) return std::nullopt;
+  return StageOutcome{CalibrateStatus::jeep_failed, std::move(why), true};
 }
 
 /// A failure after JEEP: when HOTS was judging a failed JEEP, HOTS's refusal is JEEP's failure.

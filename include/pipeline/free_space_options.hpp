@@ -23,13 +23,24 @@ struct FreeSpaceOptions {
   /// Mid-40s and Avias the highest), at the wrong answers JEEP reached 0.07-0.97, pitched-90
   /// seed 10's accepted 180-deg twin 0.283.
   double max_share = 0.25;
+  /// An answer that sends more than this share of the target's judged rays through surfaces the
+  /// base saw and the target did not is refused (at least min_points rays judged). Measured (a
+  /// probe on every simulated scenario parked, seeds 1-20; docs/experiments/free_space_check.md):
+  /// the pipeline's 440 right answers 0.000-0.123 (a narrow Tele the highest), flicar-lift seed
+  /// 16's accepted Avia twin 0.642.
+  double max_through_share = 0.2;
 };
 
 /// What the check judged (stages.jeep.free_space).
 struct FreeSpaceVerdict {
   std::size_t judged = 0;         ///< target points in the base's seen space
   std::size_t contradicting = 0;  ///< of them, where the base saw through
+  std::size_t rays_judged = 0;    ///< target rays that crossed the base's seen space
+  std::size_t rays_through = 0;   ///< of them, through a surface only the base saw
   double share() const { return judged ? double(contradicting) / double(judged) : 0.0; }
+  double through_share() const {
+    return rays_judged ? double(rays_through) / double(rays_judged) : 0.0;
+  }
 };
 
 }  // namespace ulc

@@ -1,9 +1,10 @@
 // The free-space check (pipeline/free_space.hpp): in a closed street canyon the base's rays
 // cross the whole inside, so the target's cloud placed at the truth contradicts nothing, while a
-// target turned or shifted across the street puts its walls where the base saw through; the
-// options are checked. In the pipeline: a parked rig's answer carries the verdict, a parked
-// pitched VLP-16 whose JEEP accepted the scene's twin (seed 10) is refused, and a moving rig is
-// not judged.
+// target turned or shifted across the street puts its walls where the base saw through and sends
+// its rays through the base's walls; the options are checked. In the pipeline: a parked rig's
+// answer carries the verdict, a parked pitched VLP-16 whose JEEP accepted the scene's twin (seed
+// 10) is refused by the base's rays, flicar-lift's Avia twin (seed 16) by the target's own, and
+// a moving rig is not judged.
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <limits>
@@ -57,6 +58,12 @@ Isometry3d mount() {
   return T;
 }
 
+const ulc::sim::PairTruth* find_pair(const ulc::sim::Dataset& d, const std::string& target) {
+  for (const auto& p : d.pairs)
+    if (p.target == target) return &p;
+  return nullptr;
+}
+
 ulc::PairCalibration calibrate_first_pair(const ulc::sim::Dataset& d) {
   const auto& a = d.lidars[0];
   const auto& b = d.lidars[1];
@@ -75,6 +82,8 @@ TEST_CASE("the free-space check: the truth contradicts nothing, a turned or shif
   const ulc::FreeSpaceVerdict right = ulc::free_space_verdict(scene, target, truth, o);
   CHECK(right.judged > 1000);
   CHECK(right.contradicting == 0);
+  CHECK(right.rays_judged > 1000);
+  CHECK(right.rays_through == 0);
 
   // Turned about the vertical by 90 deg (the side walls across the street) and by 180 deg (the
   // street's twin, about the target rather than the street's centre), or shifted 2 m across
@@ -90,9 +99,12 @@ TEST_CASE("the free-space check: the truth contradicts nothing, a turned or shif
        {std::pair{"turned 90 deg", turned(90.0)}, std::pair{"turned 180 deg", turned(180.0)},
         std::pair{"2 m across", across}}) {
     const ulc::FreeSpaceVerdict v = ulc::free_space_verdict(scene, target, wrong, o);
-    INFO(name << ": " << v.contradicting << " of " << v.judged);
+    INFO(name << ": " << v.contradicting << " of " << v.judged << " points, " << v.rays_through
+              << " of " << v.rays_judged << " rays");
     CHECK(v.judged > 1000);
     CHECK(v.share() > o.max_share);
+    CHECK(v.rays_judged > 1000);
+    CHECK(v.through_share() > o.max_through_share);
   }
 
   // Along the street only the end wall can tell: some contradiction, far less.
@@ -109,6 +121,18 @@ TEST_CASE("the free-space check: the truth contradicts nothing, a turned or shif
     const ulc::FreeSpaceVerdict n = ulc::free_space_verdict(base_nan, target_nan, truth, o);
     CHECK(n.contradicting == 0);
     CHECK(n.judged >= right.judged);
+  }
+  SECTION("a far point or a far answer is judged by nothing (its rays walk the base's cube only)") {
+    std::vector<Vec3d> far_target = target;
+    far_target.emplace_back(1e9, 0.0, 0.0);
+    const ulc::FreeSpaceVerdict f = ulc::free_space_verdict(scene, far_target, truth, o);
+    CHECK(f.judged == right.judged);
+    CHECK(f.rays_through == 0);
+    Isometry3d away = truth;
+    away.translation() = Vec3d(1e7, 0.0, 0.0);
+    const ulc::FreeSpaceVerdict a = ulc::free_space_verdict(scene, target, away, o);
+    CHECK(a.judged == 0);
+    CHECK(a.rays_judged == 0);
   }
 }
 
@@ -146,8 +170,11 @@ TEST_CASE("a parked rig's answer is judged by the free space the base saw",
     REQUIRE(r.jeep->free_space);
     CHECK(r.jeep->free_space->judged >= ulc::FreeSpaceOptions{}.min_points);
     CHECK(r.jeep->free_space->share() < 0.05);
+    CHECK(r.jeep->free_space->through_share() < ulc::FreeSpaceOptions{}.max_through_share);
     const auto j = ulc::io::jeep_to_json(*r.jeep);
     CHECK(j.at("free_space").at("judged").get<std::size_t>() == r.jeep->free_space->judged);
+    CHECK(j.at("free_space").at("rays_through").get<std::size_t>() ==
+          r.jeep->free_space->rays_through);
   }
   SECTION("pitched-90 seed 10: the twin JEEP accepts is refused") {
     const ulc::sim::Dataset d = parked_snapshot("pitched-90", 10);
@@ -160,6 +187,28 @@ TEST_CASE("a parked rig's answer is judged by the free space the base saw",
     REQUIRE(r.jeep);
     REQUIRE(r.jeep->free_space);
     CHECK(r.jeep->free_space->share() > ulc::FreeSpaceOptions{}.max_share);
+  }
+  SECTION("flicar-lift seed 16: the Avia's twin sends its rays through the base's walls") {
+    const ulc::sim::Dataset d = parked_snapshot("flicar-lift", 16);
+    const auto* truth = find_pair(d, "avia");
+    REQUIRE(truth);
+    const auto& a = *d.find(truth->base);
+    const auto& b = *d.find(truth->target);
+    const ulc::PairCalibration r =
+        ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, {});
+    const auto e = ulc::pose_error(truth->T_base_target, r.T_base_target);
+    INFO(ulc::to_string(r.status) << ": " << r.reason << " (" << e.rotation_deg << " deg)");
+    CHECK_FALSE((r.success && !ulc::is_calibration_success(e)));
+    REQUIRE(r.jeep);
+    REQUIRE(r.jeep->free_space);
+    const ulc::FreeSpaceVerdict& v = *r.jeep->free_space;
+    CHECK(v.through_share() > ulc::FreeSpaceOptions{}.max_through_share);
+    CHECK(r.reason.find("through surfaces the base saw") != std::string::npos);
+    // At the truth its rays meet only what the Avia itself saw.
+    const ulc::FreeSpaceVerdict at_truth = ulc::free_space_verdict(
+        a.frames[0], b.frames[0], truth->T_base_target, ulc::FreeSpaceOptions{});
+    CHECK(at_truth.rays_judged >= ulc::FreeSpaceOptions{}.min_points);
+    CHECK(at_truth.through_share() < 0.05);
   }
   SECTION("a moving rig is not judged by it") {
     const ulc::sim::Dataset& d = drive_64_32_hots();

@@ -179,6 +179,9 @@ inline Json jeep_to_json(const JeepReport& r) {
     free_space["judged"] = r.free_space->judged;
     free_space["contradicting"] = r.free_space->contradicting;
     free_space["share"] = r.free_space->share();
+    free_space["rays_judged"] = r.free_space->rays_judged;
+    free_space["rays_through"] = r.free_space->rays_through;
+    free_space["through_share"] = r.free_space->through_share();
   }
   j["free_space"] = std::move(free_space);
   return j;
