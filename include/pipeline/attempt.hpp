@@ -175,27 +175,29 @@ std::optional<StageOutcome> jeep_step(const AttemptInputs<FA, FB>& in, Attempt& 
   return std::nullopt;
 }
 
+/// One refusal of the free-space check in words: what share of which of the target's judged
+/// samples (points or rays) contradicts what the base saw, and the bound it passed.
+inline std::string refusal_text(const char* verb, double share, const char* samples,
+                                std::size_t contradicting, std::size_t judged, const char* where,
+                                double bound) {
+  char text[320];
+  std::snprintf(text, sizeof text,
+                "JEEP: its extrinsic %s %.0f %% of the target's judged %s (%zu of %zu) %s (at most "
+                "%.0f %%): a look-alike of the scene, not the mount",
+                verb, 100.0 * share, samples, contradicting, judged, where, 100.0 * bound);
+  return text;
+}
+
 /// The free-space check's refusal, in words; empty when the answer stands (too few judged, or
 /// neither share above its bound).
 inline std::string free_space_refusal(const FreeSpaceVerdict& v, const FreeSpaceOptions& o) {
-  char text[320];
-  if (v.judged >= o.min_points && v.share() > o.max_share) {
-    std::snprintf(text, sizeof text,
-                  "JEEP: its extrinsic puts %.0f %% of the target's judged points (%zu of %zu) "
-                  "where the base's rays passed through empty space (at most %.0f %%): a "
-                  "look-alike of the scene, not the mount",
-                  100.0 * v.share(), v.contradicting, v.judged, 100.0 * o.max_share);
-    return text;
-  }
-  if (v.rays_judged >= o.min_points && v.through_share() > o.max_through_share) {
-    std::snprintf(text, sizeof text,
-                  "JEEP: its extrinsic sends %.0f %% of the target's judged rays (%zu of %zu) "
-                  "through surfaces the base saw and the target did not (at most %.0f %%): a "
-                  "look-alike of the scene, not the mount",
-                  100.0 * v.through_share(), v.rays_through, v.rays_judged,
-                  100.0 * o.max_through_share);
-    return text;
-  }
+  if (v.judged >= o.min_points && v.share() > o.max_share)
+    return refusal_text("puts", v.share(), "points", v.contradicting, v.judged,
+                        "where the base's rays passed through empty space", o.max_share);
+  if (v.rays_judged >= o.min_points && v.through_share() > o.max_through_share)
+    return refusal_text("sends", v.through_share(), "rays", v.rays_through, v.rays_judged,
+                        "through surfaces the base saw and the target did not",
+                        o.max_through_share);
   return "";
 }
 

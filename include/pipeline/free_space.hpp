@@ -110,35 +110,51 @@ class SeenSpace {
   double range_;
 };
 
-/// Whether the target's ray to `hit` (in the target's frame) meets the base's seen space, and
-/// whether it goes through a surface the base saw that the target's own hits (`own`, in the
-/// target's frame) do not explain (see the conventions).
+/// What one target ray showed: whether it met the base's seen space, and whether it went through
+/// a surface only the base saw (see the conventions).
 struct RayState {
   bool judged = false, through = false;
 };
 
-/// The samples are taken only where the ray can be inside the base's cube (within sqrt(3) range
-/// of the base's origin), so a far hit or a far answer costs at most 7 range / voxel samples.
-inline RayState target_ray(const SeenSpace& base, const SeenSpace& own, const Vec3d& hit,
-                           const Isometry3d& T_base_target, double voxel, double range) {
-  RayState state;
-  const double r = hit.norm();
-  if (!(r >= 2.0 * voxel)) return state;
-  const Vec3d u = hit / r;
-  const double origin = T_base_target.translation().norm(), reach = std::sqrt(3.0) * range;
-  const double first = std::max(voxel, origin - reach);
-  const double end = std::min(r - 2.5 * voxel, origin + reach);
-  for (double t = first; t < end; t += 0.5 * voxel) {
-    const std::uint8_t seen = base.at(T_base_target * (t * u));
-    if (seen == SeenSpace::kUnknown) continue;
-    state.judged = true;
-    if (seen == SeenSpace::kOccupied && !own.near_occupied(t * u)) {
-      state.through = true;
-      return state;
-    }
+/// The target's rays placed by T_base_target in the base's seen space, against the target's own
+/// hits (`own`, in the target's frame). The samples are taken only where a ray can be inside the
+/// base's cube (within sqrt(3) range of the base's origin), so a far hit or a far answer costs
+/// at most 7 range / voxel samples.
+class TargetRays {
+ public:
+  TargetRays(const SeenSpace& base, const SeenSpace& own, const Isometry3d& T_base_target,
+             double voxel, double range)
+      : base_(base), own_(own), T_(T_base_target), voxel_(voxel) {
+    const double origin = T_base_target.translation().norm(), reach = std::sqrt(3.0) * range;
+    nearest_ = std::max(voxel, origin - reach);
+    farthest_ = origin + reach;
   }
-  return state;
-}
+
+  /// The ray from the target's origin to `hit` (in the target's frame).
+  RayState walk(const Vec3d& hit) const {
+    RayState state;
+    const double r = hit.norm();
+    if (!(r >= 2.0 * voxel_)) return state;
+    const Vec3d u = hit / r;
+    const double end = std::min(r - 2.5 * voxel_, farthest_);
+    for (double t = nearest_; t < end; t += 0.5 * voxel_) {
+      const std::uint8_t seen = base_.at(T_ * (t * u));
+      if (seen == SeenSpace::kUnknown) continue;
+      state.judged = true;
+      if (seen == SeenSpace::kOccupied && !own_.near_occupied(t * u)) {
+        state.through = true;
+        return state;
+      }
+    }
+    return state;
+  }
+
+ private:
+  const SeenSpace& base_;
+  const SeenSpace& own_;
+  Isometry3d T_;
+  double voxel_, nearest_ = 0.0, farthest_ = 0.0;
+};
 
 }  // namespace free_space_detail
 
@@ -163,12 +179,12 @@ FreeSpaceVerdict free_space_verdict(const BaseCloud& base, const TargetCloud& ta
   SeenSpace seen(o.voxel, o.range), own(o.voxel, o.range);
   seen.add_frame(base);
   own.add_hits(target);
+  const free_space_detail::TargetRays rays(seen, own, T_base_target, o.voxel, o.range);
   for (std::size_t i = 0; i < traits::size(target); i += o.stride) {
     const Vec3d hit = traits::point(target, i).template cast<double>();
     const Vec3d p = T_base_target * hit;
     if (!p.allFinite()) continue;
-    const free_space_detail::RayState ray =
-        free_space_detail::target_ray(seen, own, hit, T_base_target, o.voxel, o.range);
+    const free_space_detail::RayState ray = rays.walk(hit);
     v.rays_judged += ray.judged ? 1 : 0;
     v.rays_through += ray.through ? 1 : 0;
     const std::uint8_t state = seen.at(p);

@@ -43,6 +43,14 @@ inline ulc::sim::Dataset simulate_64_32(double seconds, std::uint64_t seed, unsi
   return ulc::sim::simulate(*ulc::sim::scenario("64-32"), o).dataset;
 }
 
+/// The simulated pair whose target is `target`, or nullptr.
+inline const ulc::sim::PairTruth* pair_with_target(const ulc::sim::Dataset& d,
+                                                   const std::string& target) {
+  for (const auto& p : d.pairs)
+    if (p.target == target) return &p;
+  return nullptr;
+}
+
 /// One frame of each LiDAR of `scenario`, parked 5 s into its route: a static snapshot.
 inline ulc::sim::Dataset parked_snapshot(const std::string& scenario, std::uint64_t seed) {
   ulc::sim::SimulationOptions o;

@@ -58,12 +58,6 @@ Isometry3d mount() {
   return T;
 }
 
-const ulc::sim::PairTruth* find_pair(const ulc::sim::Dataset& d, const std::string& target) {
-  for (const auto& p : d.pairs)
-    if (p.target == target) return &p;
-  return nullptr;
-}
-
 ulc::PairCalibration calibrate_first_pair(const ulc::sim::Dataset& d) {
   const auto& a = d.lidars[0];
   const auto& b = d.lidars[1];
@@ -190,7 +184,7 @@ TEST_CASE("a parked rig's answer is judged by the free space the base saw",
   }
   SECTION("flicar-lift seed 16: the Avia's twin sends its rays through the base's walls") {
     const ulc::sim::Dataset d = parked_snapshot("flicar-lift", 16);
-    const auto* truth = find_pair(d, "avia");
+    const auto* truth = pair_with_target(d, "avia");
     REQUIRE(truth);
     const auto& a = *d.find(truth->base);
     const auto& b = *d.find(truth->target);

@@ -27,10 +27,10 @@ ulc::PairCalibration calibrate_target(const ulc::sim::Dataset& d, const std::str
 }
 
 const ulc::Isometry3d& truth_of(const ulc::sim::Dataset& d, const std::string& target) {
-  for (const auto& p : d.pairs)
-    if (p.target == target) return p.T_base_target;
-  FAIL("no pair with target " << target);
-  return d.pairs.front().T_base_target;
+  const ulc::sim::PairTruth* pair = pair_with_target(d, target);
+  INFO("no pair with target " << target);
+  REQUIRE(pair);
+  return pair->T_base_target;
 }
 
 /// The hypothesis used is the accepted one with the largest off-ground overlap, the first among
