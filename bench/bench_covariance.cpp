@@ -2,7 +2,8 @@
 //
 //   bench_covariance [--scenarios 64-32,32-16,horizon-tele,64-horizon,32-avia,64-tele,
 //                                 ring-5x16,side-bpearl] [--seconds 10] [--runs 10]
-//                    [--first-run 0] [--estimate-offset] [--parked] [--threads 2] [--json]
+//                    [--first-run 0] [--estimate-offset] [--parked [--parked-seconds 0.1]]
+//                    [--threads 2] [--json]
 //
 // Per scenario and run (seed = run + 1) the drive is simulated and every pair of its ground truth
 // (base -> each target: one for the paper's pairs, one per target for a rig) is calibrated by
@@ -55,6 +56,7 @@ struct Config {
   std::size_t first_run = 0;
   bool estimate_offset = false;
   bool parked = false;
+  double parked_seconds = 0.1;  ///< the parked recording's length: 0.1 s is one frame per LiDAR
   int threads = 2;
   ulc_bench::Options bench;
 };
@@ -71,7 +73,7 @@ struct Outcome {
 ulc::sim::Dataset simulate(const std::string& scenario, std::uint64_t seed, const Config& c) {
   ulc::sim::SimulationOptions o;
   o.seed = seed;
-  o.seconds = c.parked ? 0.1 : c.seconds;
+  o.seconds = c.parked ? c.parked_seconds : c.seconds;
   if (c.parked) o.static_at_s = 5.0;
   const auto spec = ulc::sim::scenario(scenario);
   if (!spec) return {};
@@ -207,7 +209,7 @@ void bench(const Config& c) {
   }
   table.add_row(all.row("all"));
   ulc_bench::emit(std::cout, table, c.bench.json, "covariance", 1,
-                  {{"seconds", Cell::num(c.parked ? 0.1 : c.seconds, 1)},
+                  {{"seconds", Cell::num(c.parked ? c.parked_seconds : c.seconds, 1)},
                    {"runs", Cell::integer(static_cast<long long>(c.runs))},
                    {"first_run", Cell::integer(static_cast<long long>(c.first_run))},
                    {"offset", c.estimate_offset ? "estimated" : "known"},
@@ -231,6 +233,7 @@ int main(int argc, char** argv) {
   app.add_flag("--estimate-offset", c.estimate_offset,
                "let HOTS estimate the clock offset (default: told the true one)");
   app.add_flag("--parked", c.parked, "one frame per LiDAR of a parked rig (JEEP's covariance)");
+  app.add_option("--parked-seconds", c.parked_seconds, "the parked recording's length (s)");
   ulc_bench::add_threads_option(app, c.threads);
   CLI11_PARSE(app, argc, argv);
   bench(c);

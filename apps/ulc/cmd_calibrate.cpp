@@ -78,6 +78,12 @@ void print_summary(const io::PairResult& r) {
     std::printf("  stretch %.0f-%.0f s of the %.0f s drive (stages.selection)\n",
                 s->at("start_s").get<double>(), s->at("end_s").get<double>(),
                 s->at("drive_s").get<double>());
+  // A rig that stood still for the whole recording is calibrated as a snapshot (stillness.hpp).
+  if (const io::Json* hots = io::find_member(r.stages, "hots"))
+    if (const io::Json* still = io::find_member(*hots, "stillness");
+        still && still->is_object() && still->at("still").get<bool>())
+      std::printf("  parked  %s (stages.hots.stillness)\n",
+                  still->at("reason").get<std::string>().c_str());
   for (const auto& d : r.unobservable) std::printf("  free    %s\n", d.words.c_str());
   const Eigen::Vector3d t = r.T_base_target.translation();
   const Eigen::Vector3d rpy = ulc::rpy_from_rotation(r.T_base_target.linear()) * kDeg;

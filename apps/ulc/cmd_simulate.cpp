@@ -100,7 +100,7 @@ int run_simulate(int argc, char** argv) {
       "ground truth.",
       "ulc simulate");
   std::string scenario_name, out_dir, preview;
-  double seconds = 20.0, rate = 10.0, time_offset = 0.0, steering_ramp = 0.0;
+  double seconds = 20.0, rate = 10.0, time_offset = 0.0, steering_ramp = 0.0, parked_at = 0.0;
   long long seed = 1;
   bool list = false, quiet = false;
   std::vector<std::string> untimed;
@@ -129,6 +129,11 @@ int run_simulate(int argc, char** argv) {
              "body roll ramp into turns (default 0: they step where a street meets a "
              "corner arc)")
           ->type_name("M");
+  auto* parked_option =
+      app.add_option("--parked-at", parked_at,
+                     "the vehicle drives S seconds along its route, [0, 3600], and stands there "
+                     "for the whole recording (a parked rig)")
+          ->type_name("S");
   auto* preview_option =
       app.add_option("--preview", preview, "also draw every LiDAR's first frame, top-down and side")
           ->type_name("PNG");
@@ -169,6 +174,11 @@ int run_simulate(int argc, char** argv) {
     if (!(std::fabs(time_offset) <= 1.0))
       throw UsageError("simulate: option '--time-offset' must be within [-1, 1] s");
     options.target_clock_offset_s = time_offset;
+  }
+  if (parked_option->count() > 0) {
+    if (!(parked_at >= 0.0 && parked_at <= 3600.0))
+      throw UsageError("simulate: option '--parked-at' must be in [0, 3600] s");
+    options.static_at_s = parked_at;
   }
   options.keep_frames = false;
 

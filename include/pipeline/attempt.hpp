@@ -9,10 +9,12 @@
 //     (StageTuning::hots_odometry base: the base's own, run by the first attempt and reused),
 //     then hots::refine on those frames and poses. An odometry that could not register some
 //     frames still feeds HOTS (its poses are predictions there); one that gives no poses ends
-//     the attempt. With fewer than StageTuning::hots_min_frames frames per LiDAR HOTS is
-//     skipped after TERRA or JEEP (a static snapshot has no motion for it).
-//   - A static snapshot (fewer frames than hots_min_frames): JEEP's answer is also judged by the
-//     free space the base saw (free_space.hpp); refused, the attempt is jeep_failed.
+//     the attempt. With fewer than StageTuning::hots_min_frames frames per LiDAR, or on a rig
+//     the stillness check found standing (stillness.hpp, judged by the caller into base), HOTS
+//     is skipped after TERRA or JEEP (a static rig has no motion for it); alone, it fails.
+//   - A static rig (a snapshot of fewer frames than hots_min_frames, or parked): JEEP's answer
+//     is also judged by the free space the base saw (free_space.hpp); refused, the attempt is
+//     jeep_failed.
 //   - A failure "points at the start" when JEEP failed or HOTS's cross links refused the
 //     extrinsic (extrinsic_unconfirmed): the next TERRA hypothesis is then worth a try.
 //   - Progress: "jeep", "odometry", "hots", with the attempt's label (" (hypothesis k)").
@@ -37,6 +39,7 @@
 #include "pipeline/odometry_choice.hpp"
 #include "pipeline/options.hpp"
 #include "pipeline/pair_calibration.hpp"
+#include "pipeline/stillness.hpp"
 #include "pipeline/text_format.hpp"
 #include "ulc/core/frame_range.hpp"
 #include "ulc/core/lidar_sequence.hpp"
@@ -64,8 +67,12 @@ struct AttemptInputs {
   /// Which odometry HOTS starts from: StageTuning::hots_odometry resolved (odometry_choice.hpp).
   OdometryChoice odometry;
   /// HOTS runs, on a moving rig: it can judge a start.
-  bool can_verify() const { return run_hots && frames_left() >= options.tuning.hots_min_frames; }
+  bool can_verify() const { return run_hots && !static_rig(); }
   std::size_t frames_left() const { return std::min(a.size(), b.size()); }
+  /// Too few frames for HOTS (a snapshot), or a rig that stood still for all of them.
+  bool static_rig() const { return frames_left() < options.tuning.hots_min_frames || parked(); }
+  /// The stillness check found the rig standing still (pipeline/stillness.hpp).
+  bool parked() const { return base.stillness && base.stillness->still; }
 };
 
 /// How the stages of one attempt ended, and whether the failure points at its start.
@@ -147,6 +154,18 @@ inline bool hots_can_judge(const JeepReport& j) {
   return hots_can_judge(j.status, j.extrinsic);
 }
 
+/// JEEP's options for this call: on a parked rig, its first frame pair alone, as a snapshot's.
+/// JEEP's pose phase over five frames of a standing rig let its poses slide where single
+/// frames of a rig's VLP-16s pin little, and let a twin through (bench_covariance --parked
+/// --parked-seconds 2, seeds 1-3: 3 answers beyond 1 deg / 10 cm in 117 with five frames; the
+/// single frame's census: docs/experiments/parked_recordings.md).
+template <class FA, class FB>
+jeep::JeepOptions jeep_options(const AttemptInputs<FA, FB>& in) {
+  jeep::JeepOptions o = in.options.tuning.jeep;
+  if (in.parked()) o.frames = 1;
+  return o;
+}
+
 /// The JEEP stage; an outcome when it ends the attempt.
 template <class FA, class FB>
 std::optional<StageOutcome> jeep_step(const AttemptInputs<FA, FB>& in, Attempt& at) {
@@ -155,7 +174,7 @@ std::optional<StageOutcome> jeep_step(const AttemptInputs<FA, FB>& in, Attempt& 
   notify(in.options, stage, 0.0);
   const jeep::JeepResult j =
       jeep::run_jeep(in.a.frames, in.a.times, in.b.frames, in.b.times, at.extrinsic,
-                     in.options.tuning.jeep, count_progress(in.options, stage));
+                     jeep_options(in), count_progress(in.options, stage));
   at.out.jeep = jeep_report(j, at.extrinsic, seconds_since(t0));
   at.out.timing_s.jeep = at.out.jeep->seconds;
   notify(in.options, stage, 1.0);
@@ -227,16 +246,23 @@ inline StageOutcome failed_after_jeep(const Attempt& at, CalibrateStatus status,
                       points_at_start};
 }
 
-/// HOTS skipped for want of frames: the previous stage's extrinsic stands.
+/// Why HOTS has no motion to work with: too few frames, or a rig that stood still.
+template <class FA, class FB>
+std::string no_motion_reason(const AttemptInputs<FA, FB>& in) {
+  if (in.parked()) return in.base.stillness->reason + " (HOTS needs a moving rig)";
+  return "only " + std::to_string(in.frames_left()) + " frame(s) per LiDAR from frame " +
+         std::to_string(in.options.frame_index) + " (HOTS needs " +
+         std::to_string(in.options.tuning.hots_min_frames) + " of a moving rig)";
+}
+
+/// HOTS skipped on a static rig (a snapshot, or parked): the previous stage's extrinsic stands.
 template <class FA, class FB>
 StageOutcome skip_hots(const AttemptInputs<FA, FB>& in, Attempt& at) {
   HotsReport h;
   h.run = HotsRun::skipped;
-  h.reason = "only " + std::to_string(in.frames_left()) + " frame(s) per LiDAR from frame " +
-             std::to_string(in.options.frame_index) + " (HOTS needs " +
-             std::to_string(in.options.tuning.hots_min_frames) +
-             " of a moving rig); the extrinsic is the previous stage's";
+  h.reason = no_motion_reason(in) + "; the extrinsic is the previous stage's";
   h.initial = h.extrinsic = at.extrinsic;
+  if (in.base.stillness) h.stillness = *in.base.stillness;
   at.out.hots = h;
   return {CalibrateStatus::ok, "", false};
 }
@@ -351,6 +377,7 @@ StageOutcome hots_step(const AttemptInputs<FA, FB>& in, Attempt& at) {
   at.out.hots->odometry_reused = odometry_reused;
   at.out.hots->odometry = in.odometry.odometry;
   at.out.hots->odometry_choice = in.odometry.why;
+  if (in.base.stillness) at.out.hots->stillness = *in.base.stillness;
   if (at.out.hots->run == HotsRun::odometry_failed)
     return failed_after_jeep(
         at, CalibrateStatus::hots_failed,
@@ -392,14 +419,14 @@ StageOutcome run_attempt(const AttemptInputs<FA, FB>& in, const Isometry3d& star
                          std::string label, bool hots_may_judge, PairCalibration& out) {
   Attempt at{start, std::move(label), hots_may_judge, {}, out};
   out.T_base_target = start;
-  const bool snapshot = in.frames_left() < in.options.tuning.hots_min_frames;
   if (in.run_jeep) {
     if (auto ended = jeep_step(in, at)) return *ended;
-    if (snapshot)
+    if (in.static_rig())
       if (auto ended = free_space_step(in, at)) return *ended;
   }
   if (!in.run_hots) return {CalibrateStatus::ok, "", false};
-  if (snapshot && (in.run_terra || in.run_jeep)) return skip_hots(in, at);
+  if (in.static_rig() && (in.run_terra || in.run_jeep)) return skip_hots(in, at);
+  if (in.parked()) return {CalibrateStatus::hots_failed, "HOTS: " + no_motion_reason(in), false};
   return hots_step(in, at);
 }
 

@@ -139,8 +139,7 @@ PairCalibration snapshot_contest(const AttemptInputs<FA, FB>& in, const StartRot
 /// static rig: the check is skipped when the target moved between the two frames).
 template <class FA, class FB>
 bool opens_contest(const AttemptInputs<FA, FB>& in, const HypothesisRun& first) {
-  const bool snapshot = in.frames_left() < in.options.tuning.hots_min_frames;
-  return snapshot && in.options.tuning.hypotheses.snapshot_rivals > 0 &&
+  return in.static_rig() && in.options.tuning.hypotheses.snapshot_rivals > 0 &&
          std::isfinite(first.contest_score);
 }
 

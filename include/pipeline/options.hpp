@@ -21,6 +21,7 @@
 #include "pipeline/map_terra_options.hpp"
 #include "pipeline/odometry_choice_options.hpp"
 #include "pipeline/stages.hpp"
+#include "pipeline/stillness_options.hpp"
 #include "pipeline/vouch_options.hpp"
 #include "terra/search_params.hpp"
 #include "ulc/core/types.hpp"
@@ -74,6 +75,9 @@ struct BaseWork {
   /// HOTS's preparation of the base's frames on those poses: deskewed and thinned frames, the
   /// hierarchy and its bridges (hots::refine's prepared_a; used only when built from them).
   std::shared_ptr<hots::PreparedLidar<float>> hots;
+  /// Whether the rig stood still over the base's frames from frame_index
+  /// (pipeline/stillness.hpp).
+  std::shared_ptr<const StillnessReport> stillness;
 };
 
 /// Called with the running stage's name ("terra", "jeep", "odometry", "hots") and its fraction
@@ -94,6 +98,9 @@ struct StageTuning {
   /// has no motion to work with, so after TERRA or JEEP it is skipped (stages.hots says so) and
   /// their extrinsic is the answer; as the only stage it fails.
   std::size_t hots_min_frames = 10;
+  /// A rig that stood still for the whole recording (pipeline/stillness.hpp) is calibrated as a
+  /// static snapshot: HOTS is skipped, it has no motion to work with.
+  StillnessOptions stillness;
   /// HOTS's answer is used only when the odometry it built on saw the motion: the median
   /// condition of its steps (odometry::median_condition) at least this, else hots_failed with
   /// stages.hots.status odometry_degenerate. In a tunnel the odometry follows its motion model

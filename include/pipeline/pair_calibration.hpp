@@ -210,6 +210,9 @@ struct HotsReport {
   /// from an earlier hypothesis or target on the same poses: its time is not in seconds.
   bool base_prepared_reused = false;
   double seconds = 0.0;  ///< hots::refine alone
+  /// Whether the rig stood still (pipeline/stillness.hpp); nothing when the check did not run
+  /// (too few frames, or it is off).
+  std::optional<StillnessReport> stillness;
 };
 
 // What the data cannot vouch for (pipeline/vouch.hpp, docs/pipeline.md "Clocks and point
@@ -238,7 +241,8 @@ struct ClockReport {
   ClockSource source = ClockSource::not_estimated;
   double speed_mps = 0.0;             ///< the target's largest speed over JEEP's frames
   double translation_per_ms_m = 0.0;  ///< how far 1 ms of offset moves the translation
-  /// slow (no plausible offset matters), lag_within_bar, lag_exceeds_bar, lag_unobservable,
+  /// slow (no plausible offset matters), parked (the rig stood still: stillness.hpp),
+  /// lag_within_bar, lag_exceeds_bar, lag_unobservable,
   /// or empty when the source is given or estimated.
   std::string verdict;
   bool lag_checked = false;  ///< the lag was estimated from both LiDARs' rotation rates

@@ -31,8 +31,10 @@
 //     odometry that could not register some frames still feeds HOTS (its poses are predictions
 //     there; the report counts them); an odometry that gives no poses, or a HOTS that fails, ends
 //     the call with hots_failed, keeping the previous extrinsic. With fewer than
-//     tuning.hots_min_frames frames per LiDAR (single frames, as in a static rig's snapshot) HOTS
-//     is skipped after TERRA or JEEP: stages.hots has status "skipped" and the reason. A HOTS whose
+//     tuning.hots_min_frames frames per LiDAR (single frames, as in a static rig's snapshot), or
+//     on a rig that stood still for the whole recording (stillness.hpp: judged once per base
+//     before the attempts when JEEP or HOTS runs), HOTS is skipped after TERRA or JEEP:
+//     stages.hots has status "skipped" and the reason. A HOTS whose
 //     clock offset the drive does not pin down fails too (time_offset_untrusted: the extrinsic
 //     would carry the offset's error times the speed); a caller who knows the clocks' offset sets
 //     time_offset_s, and then no offset is estimated or checked.
@@ -63,6 +65,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstddef>
+#include <memory>
 #include <optional>
 #include <string>
 #include <type_traits>
@@ -199,6 +202,19 @@ OdometryChoice hots_odometry_choice(const AttemptInputs<FA, FB>& in) {
                          in.options.tuning.odometry_choice);
 }
 
+/// Whether the rig stood still over the base's frames (stillness.hpp), into in.base: judged
+/// once per base when JEEP or HOTS will run on enough frames for HOTS (a rig's targets share
+/// it, as they share the odometry).
+template <class FA, class FB>
+void judge_stillness_once(const AttemptInputs<FA, FB>& in) {
+  const StageTuning& tuning = in.options.tuning;
+  if (in.base.stillness || !(in.run_jeep || in.run_hots) || !tuning.stillness.enabled ||
+      in.frames_left() < tuning.hots_min_frames)
+    return;
+  in.base.stillness = std::make_shared<const StillnessReport>(
+      judge_stillness(in.a.frames, in.a.times, tuning.stillness));
+}
+
 /// TERRA alone: its best rotation is the answer.
 inline PairCalibration terra_only(const StartRotations& starts, PairCalibration& r,
                                   const Finish& finish) {
@@ -262,6 +278,7 @@ PairCalibration run_pipeline(const FA& frames_a, const std::vector<double>& time
                            options.base_work,
                            {}};
   in.odometry = hots_odometry_choice(in);
+  judge_stillness_once(in);
   r.point_times_base = point_times_before(in.a.frames);
   r.point_times_target = point_times_before(in.b.frames);
   if (!in.run_terra) return attempts_on_chosen_odometry(in, nullptr, r, finish);

@@ -212,6 +212,7 @@ void calibrate_directly(const std::vector<RigLidar<Frames>>& lidars, std::size_t
     t.direct = calibrate(lidars[base], lidars[k], o);
     if (!shared.odometry) shared.odometry = t.direct.base_work.odometry;
     if (!shared.hots) shared.hots = t.direct.base_work.hots;
+    if (!shared.stillness) shared.stillness = t.direct.base_work.stillness;
     t.result = t.direct;
     rig.targets.push_back(std::move(t));
   }

@@ -20,6 +20,8 @@
 //     pipeline/point_times.hpp; what it could not time is what reaches this check.)
 //   - A covariance wider than a success allows: more than a 5 % chance of lying beyond 10 cm or
 //     1 deg along some direction, status uncertain (confidence.hpp).
+//   - A rig the stillness check found parked (stillness.hpp): no offset and no sweep moves its
+//     extrinsic; the clock's verdict is "parked" and a LiDAR without point times is named only.
 //   Every result whose translation JEEP or HOTS made has a ClockReport (PairCalibration::clock)
 //   saying where the offset came from and, when not estimated, how far 1 ms moves the answer.
 #pragma once
@@ -114,6 +116,12 @@ ClockReport unestimated_clock(const AttemptInputs<FA, FB>& in, const PairCalibra
     c.note = head;
     return c;
   }
+  if (in.parked()) {
+    c.verdict = "parked";
+    c.note = "the clock offset was not estimated, and need not be: " + in.base.stillness->reason +
+             ", so no offset moves the extrinsic";
+    return c;
+  }
   if (c.speed_mps * v.lag.max_lag_s <= v.max_translation_effect_m) {
     c.verdict = "slow";
     c.note = head + "; even " + fixed(v.lag.max_lag_s * 1000.0, 0) + " ms would move it by " +
@@ -168,10 +176,14 @@ ClockReport clock_report(const AttemptInputs<FA, FB>& in, const PairCalibration&
 }
 
 /// A LiDAR without point times, when JEEP's speed says how far its sweeps move the answer:
-/// the reason to refuse, or empty.
+/// the reason to refuse, or empty. A parked rig's sweeps have no motion to undo.
 inline std::string undeskewed_sweep(const char* which, PointTimesReport& p, double period,
-                                    const PairCalibration& r, const VouchOptions& v) {
+                                    const PairCalibration& r, const VouchOptions& v, bool parked) {
   if (p.source != PointTimeSource::none || !r.jeep) return "";
+  if (parked) {
+    p.note += "; the rig stood still: its sweeps have no motion to undo";
+    return "";
+  }
   const double bound = r.jeep->target_speed_mps * period / 2.0;
   const std::string effect = "at this drive's speed of " + fixed(r.jeep->target_speed_mps, 2) +
                              " m/s and a " + fixed(period * 1000.0, 0) +
@@ -193,7 +205,8 @@ StageOutcome vouch(const AttemptInputs<FA, FB>& in, PairCalibration& r) {
   for (auto [which, report, times] :
        {std::make_tuple("base", &r.point_times_base, &in.a.times),
         std::make_tuple("target", &r.point_times_target, &in.b.times)}) {
-    const std::string why = undeskewed_sweep(which, *report, odometry::frame_period(*times), r, v);
+    const std::string why =
+        undeskewed_sweep(which, *report, odometry::frame_period(*times), r, v, in.parked());
     if (!why.empty()) return {CalibrateStatus::point_times_missing, why, false};
   }
   if (!r.jeep && !(r.hots && r.hots->run == HotsRun::refined)) return kept;  // TERRA's rotation

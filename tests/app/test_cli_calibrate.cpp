@@ -2,9 +2,10 @@
 // --stages terra writes the result file of docs/design.md with a rotation near the ground truth;
 // terra,jeep passes `ulc evaluate`; jeep alone takes --initial as numbers or as a result file;
 // --stages hots is accepted and runs over every frame, and --synced-clocks skips the offset;
-// a target that cannot be calibrated gives exit code 1 and still its entry; bad usage gives exit
-// code 2 and one line naming the problem; and on the real croon_0003 sample TERRA finds both
-// side LiDARs within 5 deg of the shipped calibration.
+// a parked rig's recording is calibrated without a clock offset, HOTS skipped and the output
+// saying so; a target that cannot be calibrated gives exit code 1 and still its entry; bad usage
+// gives exit code 2 and one line naming the problem; and on the real croon_0003 sample TERRA finds
+// both side LiDARs within 5 deg of the shipped calibration.
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <cstdio>
@@ -30,15 +31,16 @@ namespace {
 using ulc_test::kUlc;
 constexpr double kDeg = 3.14159265358979323846 / 180.0;
 
-/// A 0.6 s 64-32 drive (six frames per LiDAR; or `seconds`) in its own temporary folder, removed
-/// afterwards.
+/// A 0.6 s 64-32 drive (six frames per LiDAR; or `seconds`, and `ulc simulate`'s `more`
+/// options) in its own temporary folder, removed afterwards.
 struct Dataset {
   fs::path dir;
-  explicit Dataset(const std::string& name, const std::string& seconds = "0.6")
+  explicit Dataset(const std::string& name, const std::string& seconds = "0.6",
+                   const std::string& more = "")
       : dir(fs::temp_directory_path() / name) {
     fs::remove_all(dir);
     const auto run = run_command(kUlc + " simulate --quiet --scenario 64-32 --seconds " + seconds +
-                                 " --seed 2 --out " + quote(dir.string()));
+                                 " --seed 2" + more + " --out " + quote(dir.string()));
     INFO(run.output);
     REQUIRE(run.exit_code == 0);
   }
@@ -516,4 +518,26 @@ TEST_CASE("ulc calibrate --budget calibrates the best stretch of a longer drive 
   // HOTS ran on the stretch alone, and the answer is right.
   CHECK(results[0].stages.at("hots").at("frames_base").get<double>() <= 51);
   CHECK(evaluate_success(d, out));
+}
+
+TEST_CASE("ulc calibrate on a parked rig's recording: HOTS skipped, no clock offset needed",
+          "[app][calibrate][stillness]") {
+  const Dataset d("ulc_test_calibrate_parked", "1.5", " --parked-at 3");
+  const std::string out = d.file("result.json");
+  const auto run =
+      run_command(kUlc + " calibrate --quiet" + d.pair_args() + " --output " + quote(out));
+  INFO(run.output);
+  REQUIRE(run.exit_code == 0);
+  CHECK_THAT(run.output, Catch::Contains("parked  the rig stood still"));
+  const auto results = ulc::io::read_result_file(out);
+  REQUIRE(results.size() == 1);
+  const auto& hots = results[0].stages.at("hots");
+  CHECK(hots.at("status").get<std::string>() == "skipped");
+  CHECK(hots.at("stillness").at("still").get<bool>());
+  CHECK(evaluate_success(d, out));
+
+  const auto bad = run_command(kUlc + " simulate --quiet --scenario 64-32 --seconds 0.3 " +
+                               "--parked-at -1 --out " + quote(d.file("x")));
+  CHECK(bad.exit_code == 2);
+  CHECK_THAT(bad.output, Catch::Contains("'--parked-at' must be in [0, 3600] s"));
 }

@@ -43,6 +43,27 @@ inline ulc::sim::Dataset simulate_64_32(double seconds, std::uint64_t seed, unsi
   return ulc::sim::simulate(*ulc::sim::scenario("64-32"), o).dataset;
 }
 
+/// The faces of the axis-aligned box from lo to hi on a `step` grid; only the pairs of faces
+/// across the axes in `axes` (a corridor along x leaves out its ends: {1, 2}).
+inline std::vector<Eigen::Vector3d> box_faces(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                                              double step,
+                                              const std::vector<int>& axes = {0, 1, 2}) {
+  std::vector<Eigen::Vector3d> points;
+  for (const int axis : axes)
+    for (const double side : {lo[axis], hi[axis]}) {
+      const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+      for (double a = lo[u]; a <= hi[u]; a += step)
+        for (double b = lo[v]; b <= hi[v]; b += step) {
+          Eigen::Vector3d p;
+          p[axis] = side;
+          p[u] = a;
+          p[v] = b;
+          points.push_back(p);
+        }
+    }
+  return points;
+}
+
 /// The simulated pair whose target is `target`, or nullptr.
 inline const ulc::sim::PairTruth* pair_with_target(const ulc::sim::Dataset& d,
                                                    const std::string& target) {

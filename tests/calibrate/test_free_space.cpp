@@ -27,21 +27,7 @@ namespace {
 /// The six faces of a closed street canyon (x in [-20, 20] along it, y in [-5, 5], z in
 /// [-2, 10]) on a 0.2 m grid: every ray of a LiDAR inside it comes back.
 std::vector<Vec3d> canyon() {
-  const Vec3d lo(-20.0, -5.0, -2.0), hi(20.0, 5.0, 10.0);
-  std::vector<Vec3d> points;
-  for (int axis = 0; axis < 3; ++axis)
-    for (const double side : {lo[axis], hi[axis]}) {
-      const int u = (axis + 1) % 3, v = (axis + 2) % 3;
-      for (double a = lo[u]; a <= hi[u]; a += 0.2)
-        for (double b = lo[v]; b <= hi[v]; b += 0.2) {
-          Vec3d p;
-          p[axis] = side;
-          p[u] = a;
-          p[v] = b;
-          points.push_back(p);
-        }
-    }
-  return points;
+  return box_faces(Vec3d(-20.0, -5.0, -2.0), Vec3d(20.0, 5.0, 10.0), 0.2);
 }
 
 /// The canyon as the target sees it from `T_base_target` (convex: every face in view).

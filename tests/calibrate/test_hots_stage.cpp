@@ -43,8 +43,11 @@ TEST_CASE("on a 3 s drive HOTS says the clock offset cannot be trusted", "[calib
   CHECK(c.hots->statistics.sequence.time_offset_checked);
   CHECK_FALSE(c.hots->statistics.sequence.time_offset_trusted);
   CHECK(same_bits(c.T_base_target, c.jeep->extrinsic));  // a failed HOTS keeps JEEP's answer
+  REQUIRE(c.hots->stillness);  // a moving rig: the stillness check did not skip HOTS
+  CHECK_FALSE(c.hots->stillness->still);
   const ulc::io::PairResult r = ulc::io::to_pair_result(c, "lidar64", "lidar32");
   CHECK(r.stages.at("hots").at("time_offset_trusted").get<bool>() == false);
+  CHECK(r.stages.at("hots").at("stillness").at("still").get<bool>() == false);
 }
 
 TEST_CASE("terra,jeep,hots recovers the 64-32 mounting with synchronised clocks",

@@ -78,13 +78,17 @@ TEST_CASE("a known offset calibrates the same drive, and the result says it was 
 
 TEST_CASE("a parked rig with an unestimated offset stays ok: no offset can move it",
           "[calibrate][vouch]") {
-  const auto d = drive("64-32", 1.0, 0.05, true);
+  // Five frames: too few for the stillness check, JEEP's speed says no offset matters. Ten:
+  // the check finds the rig standing.
+  const auto [seconds, verdict] =
+      GENERATE(table<double, std::string>({{0.5, "slow"}, {1.0, "parked"}}));
+  const auto d = drive("64-32", seconds, 0.05, true);
   const auto r = terra_jeep(d, std::nullopt);
-  INFO(ulc::to_string(r.status) << ": " << r.reason);
+  INFO(seconds << " s: " << ulc::to_string(r.status) << ": " << r.reason);
   REQUIRE(r.success);
   REQUIRE(r.clock);
   CHECK(r.clock->source == ulc::ClockSource::not_estimated);
-  CHECK(r.clock->verdict == "slow");
+  CHECK(r.clock->verdict == verdict);
   CHECK(contains(r.clock->note, "was not estimated"));
   CHECK(ulc::is_calibration_success(ulc::pose_error(d.pairs.at(0).T_base_target, r.T_base_target)));
 }

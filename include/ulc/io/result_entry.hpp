@@ -214,6 +214,21 @@ inline Json cross_link_records_to_json(const std::vector<hots::CrossLinkRecord>&
   return j;
 }
 
+/// stages.hots.stillness: whether the rig stood still (pipeline/stillness.hpp).
+inline Json stillness_to_json(const StillnessReport& s) {
+  Json j = Json::object();
+  j["still"] = s.still;
+  j["decided"] = s.decided;
+  j["frames_compared"] = s.frames_compared;
+  j["span_s"] = s.span_s;
+  j["max_travel_m"] = s.max_travel_m;
+  j["max_turn_deg"] = s.max_turn_deg;
+  j["min_condition"] = s.min_condition;
+  j["min_inlier_ratio"] = s.min_inlier_ratio;
+  j["reason"] = s.reason;
+  return j;
+}
+
 /// stages.hots: the odometry that fed it, the graph's and the time synchronisation's statistics
 /// and the spread-against-offset curve.
 inline Json hots_to_json(const HotsReport& h) {
@@ -294,6 +309,8 @@ inline Json hots_to_json(const HotsReport& h) {
   j["odometry_reused"] = h.odometry_reused;
   j["base_prepared_reused"] = h.base_prepared_reused;
   j["seconds"] = h.seconds;
+  // Null when the check did not run (too few frames, or off).
+  j["stillness"] = h.stillness ? stillness_to_json(*h.stillness) : Json();
   return j;
 }
 
