@@ -4,7 +4,8 @@
 // HOTS moved JEEP's 1.1 cm answer to 2.0 cm), and the clock offset cannot move its extrinsic.
 // Such a recording is calibrated as a static snapshot is (attempt.hpp): JEEP's answer, judged
 // by the free-space check and the contest of TERRA's hypotheses, and HOTS skipped with the
-// reason (docs/pipeline.md, "A parked rig").
+// reason (docs/pipeline.md, "Hand-over between stages"; docs/BENCHMARKS.md, "A parked rig
+// recorded for seconds").
 //
 // Conventions this header owns:
 //   - Only the base's frames are looked at (the rig is rigid): StillnessOptions::samples frames
