@@ -39,6 +39,7 @@
 #include "pipeline/odometry_choice.hpp"
 #include "pipeline/options.hpp"
 #include "pipeline/pair_calibration.hpp"
+#include "pipeline/parked_stack.hpp"
 #include "pipeline/stillness.hpp"
 #include "pipeline/text_format.hpp"
 #include "ulc/core/frame_range.hpp"
@@ -66,6 +67,9 @@ struct AttemptInputs {
   mutable BaseWork base;
   /// Which odometry HOTS starts from: StageTuning::hots_odometry resolved (odometry_choice.hpp).
   OdometryChoice odometry;
+  /// On a parked rig, JEEP's one frame pair: each LiDAR's first frames stacked
+  /// (parked_stack.hpp), made by the first attempt and reused by every later one.
+  mutable std::shared_ptr<const ParkedStack<FrameRange<FramesA>, FrameRange<FramesB>>> stack;
   /// HOTS runs, on a moving rig: it can judge a start.
   bool can_verify() const { return run_hots && !static_rig(); }
   std::size_t frames_left() const { return std::min(a.size(), b.size()); }
@@ -154,16 +158,38 @@ inline bool hots_can_judge(const JeepReport& j) {
   return hots_can_judge(j.status, j.extrinsic);
 }
 
-/// JEEP's options for this call: on a parked rig, its first frame pair alone, as a snapshot's.
-/// JEEP's pose phase over five frames of a standing rig let its poses slide where single
-/// frames of a rig's VLP-16s pin little, and let a twin through (bench_covariance --parked
-/// --parked-seconds 2, seeds 1-3: 3 answers beyond 1 deg / 10 cm in 117 with five frames; the
-/// single frame's census: docs/experiments/parked_recordings.md).
+/// JEEP's options for this call: on a parked rig, one frame pair (its stacked frames), as a
+/// snapshot's. JEEP's pose phase over five frames of a standing rig let its poses slide where
+/// single frames of a rig's VLP-16s pin little, and let a twin through (bench_covariance
+/// --parked --parked-seconds 2, seeds 1-3: 3 answers beyond 1 deg / 10 cm in 117 with five
+/// frames: docs/experiments/parked_recordings.md).
 template <class FA, class FB>
 jeep::JeepOptions jeep_options(const AttemptInputs<FA, FB>& in) {
   jeep::JeepOptions o = in.options.tuning.jeep;
   if (in.parked()) o.frames = 1;
   return o;
+}
+
+/// The calibration phase's finest source voxel (m); 0 without stages (JEEP refuses those).
+inline double finest_source_voxel(const jeep::JeepOptions& o) {
+  return o.calibration.stages.empty() ? 0.0 : o.calibration.stages.back().source_voxel;
+}
+
+/// JEEP from `start` on the call's frames, or on a parked rig on its stacked frames (made once).
+template <class FA, class FB>
+jeep::JeepResult run_jeep_stage(const AttemptInputs<FA, FB>& in, const Isometry3d& start,
+                                const std::string& stage) {
+  const jeep::JeepOptions options = jeep_options(in);
+  const odometry::ProgressFn progress = count_progress(in.options, stage);
+  if (!in.parked())
+    return jeep::run_jeep(in.a.frames, in.a.times, in.b.frames, in.b.times, start, options,
+                          progress);
+  if (!in.stack)
+    in.stack = std::make_shared<const ParkedStack<FrameRange<FA>, FrameRange<FB>>>(
+        parked_stack(in.a.frames, in.a.times, in.b.frames, in.options.tuning.parked_stack,
+                     finest_source_voxel(options)));
+  const auto& s = *in.stack;
+  return jeep::run_jeep(s.a, s.times_a, s.b, s.times_b, start, options, progress);
 }
 
 /// The JEEP stage; an outcome when it ends the attempt.
@@ -172,10 +198,13 @@ std::optional<StageOutcome> jeep_step(const AttemptInputs<FA, FB>& in, Attempt& 
   const auto t0 = std::chrono::steady_clock::now();
   const std::string stage = "jeep" + at.label;
   notify(in.options, stage, 0.0);
-  const jeep::JeepResult j =
-      jeep::run_jeep(in.a.frames, in.a.times, in.b.frames, in.b.times, at.extrinsic,
-                     jeep_options(in), count_progress(in.options, stage));
+  const jeep::JeepResult j = run_jeep_stage(in, at.extrinsic, stage);
   at.out.jeep = jeep_report(j, at.extrinsic, seconds_since(t0));
+  if (in.stack) {
+    at.out.jeep->stacked_frames_base = in.stack->frames_a;
+    at.out.jeep->stacked_frames_target = in.stack->frames_b;
+    at.out.jeep->stack_covariance_scale = in.stack->covariance_scale();
+  }
   at.out.timing_s.jeep = at.out.jeep->seconds;
   notify(in.options, stage, 1.0);
   if (!j.ok()) {
@@ -190,6 +219,8 @@ std::optional<StageOutcome> jeep_step(const AttemptInputs<FA, FB>& in, Attempt& 
   if (j.ok()) {
     at.out.T_base_target = at.extrinsic;
     at.out.covariance_6x6 = j.covariance_6x6;
+    if (in.stack && at.out.covariance_6x6)
+      *at.out.covariance_6x6 *= in.stack->covariance_scale();  // parked_stack.hpp: views
   }
   return std::nullopt;
 }

@@ -101,6 +101,8 @@ struct StageTuning {
   /// A rig that stood still for the whole recording (pipeline/stillness.hpp) is calibrated as a
   /// static snapshot: HOTS is skipped, it has no motion to work with.
   StillnessOptions stillness;
+  /// ... and JEEP takes each LiDAR's first frames stacked into one cloud (parked_stack.hpp).
+  ParkedStackOptions parked_stack;
   /// HOTS's answer is used only when the odometry it built on saw the motion: the median
   /// condition of its steps (odometry::median_condition) at least this, else hots_failed with
   /// stages.hots.status odometry_degenerate. In a tunnel the odometry follows its motion model

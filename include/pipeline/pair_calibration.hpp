@@ -136,6 +136,10 @@ struct JeepReport {
   Isometry3d extrinsic = Isometry3d::Identity();  ///< JEEP's last extrinsic (even if failed)
   int rounds = 0;
   std::size_t frame_pairs = 0;  ///< pairs used (<= JeepOptions::frames)
+  /// On a parked rig, the frames stacked into JEEP's one pair (parked_stack.hpp); 0 otherwise.
+  std::size_t stacked_frames_base = 0, stacked_frames_target = 0;
+  /// ... and what its covariance was scaled by: the stacks' frames per cell (1 when unstacked).
+  double stack_covariance_scale = 1.0;
   RegistrationStatus calibration_status =
       RegistrationStatus::ok;        ///< of the last map-to-map registration
   double final_cost = 0.0;           ///< of the last map-to-map registration

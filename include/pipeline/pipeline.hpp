@@ -276,6 +276,7 @@ PairCalibration run_pipeline(const FA& frames_a, const std::vector<double>& time
                            has_stage(options.stages, Stage::jeep),
                            has_stage(options.stages, Stage::hots),
                            options.base_work,
+                           {},
                            {}};
   in.odometry = hots_odometry_choice(in);
   judge_stillness_once(in);

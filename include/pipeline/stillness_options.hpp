@@ -1,5 +1,6 @@
 // The options and the report of the stillness check: did the rig stand still for the whole
-// recording? (pipeline/stillness.hpp). Light: no algorithm.
+// recording? (pipeline/stillness.hpp), and what a still rig's JEEP stacks (parked_stack.hpp).
+// Light: no algorithm.
 #pragma once
 
 #include <cstddef>
@@ -26,6 +27,12 @@ struct StillnessOptions {
   double min_condition = 0.03;
   /// ... and one whose points mostly found no surface of the first frame (a large move) neither.
   double min_inlier_ratio = 0.5;
+};
+
+/// What a rig found still gives JEEP (pipeline/parked_stack.hpp).
+struct ParkedStackOptions {
+  /// Frames per LiDAR stacked into JEEP's one frame pair (1: the first frame alone).
+  std::size_t frames = 10;
 };
 
 /// What the check found (stages.hots.stillness).

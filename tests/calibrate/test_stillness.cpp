@@ -5,11 +5,13 @@
 // result says why) without a known clock offset, and a moving drive is judged moving.
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <limits>
 #include <string>
 #include <vector>
 
 #include "calibrate_test_util.hpp"
 #include "pipeline/calibrate.hpp"
+#include "pipeline/parked_stack.hpp"
 #include "pipeline/stillness.hpp"
 #include "ulc/core/pose_error.hpp"
 #include "ulc/io/result_entry.hpp"
@@ -125,6 +127,41 @@ TEST_CASE("a corridor cannot show a move along it: its frames are never judged s
   }
 }
 
+TEST_CASE("a parked rig's stack holds its first frames' finite points, on the base's first time",
+          "[calibrate][stillness]") {
+  Recording a = record(room(), 0.0);
+  const Recording b = record(corridor(), 0.0);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  a.frames[1].push_back(Vec3d(nan, 0.0, 1.0));
+  const ulc::ParkedStack<std::vector<Frame>, std::vector<Frame>> s =
+      ulc::parked_stack(a.frames, a.times, b.frames, ulc::ParkedStackOptions{3}, 0.4);
+  CHECK(s.frames_a == 3);
+  CHECK(s.frames_b == 3);
+  REQUIRE(s.a.size() == 1);
+  REQUIRE(s.b.size() == 1);
+  CHECK(s.a[0].size() == 3 * a.frames[0].size());  // the NaN point left out
+  CHECK(s.b[0].size() == 3 * b.frames[0].size());
+  CHECK_FALSE(s.a[0].has_times());  // a standing rig's sweep has nothing to undo
+  CHECK(s.a[0].points[a.frames[0].size()] == a.frames[1][0]);
+  CHECK(s.times_a == std::vector<double>{100.0});
+  CHECK(s.times_b == s.times_a);
+  // Frames of one spot repeat each other's cells: every cell seen by all three.
+  CHECK(s.views_a == Approx(3.0));
+  CHECK(s.views_b == Approx(3.0));
+  CHECK(s.covariance_scale() == Approx(3.0));
+
+  const auto all = ulc::parked_stack(a.frames, a.times, b.frames, ulc::ParkedStackOptions{50}, 0.4);
+  CHECK(all.frames_a == a.frames.size());  // no more than the recording has
+}
+
+TEST_CASE("frames that fill new cells are each cell's only view", "[calibrate][stillness]") {
+  const std::vector<Frame> rosette{
+      {Vec3d(0, 0, 0), Vec3d(0.1, 0, 0)}, {Vec3d(5, 0, 0)}, {Vec3d(10, 0, 0), Vec3d(0.2, 0, 0)}};
+  CHECK(ulc::views_per_cell(rosette, 3, 0.4) == Approx(4.0 / 3.0));  // 4 views of 3 cells
+  CHECK(ulc::views_per_cell(rosette, 2, 0.4) == Approx(1.0));
+  CHECK(ulc::views_per_cell(rosette, 3, 0.0) == 0.0);  // no cells: the scale stays 1
+}
+
 TEST_CASE("a parked rig recorded for seconds is calibrated without a clock offset, HOTS skipped",
           "[calibrate][stillness]") {
   const ulc::sim::Dataset d = parked_64_32(2.0);
@@ -146,12 +183,17 @@ TEST_CASE("a parked rig recorded for seconds is calibrated without a clock offse
                                  Catch::Contains("HOTS needs a moving rig"));
   REQUIRE(r.jeep);
   CHECK(r.jeep->free_space);  // judged as a snapshot is
+  CHECK(r.jeep->frame_pairs == 1);
+  CHECK(r.jeep->stacked_frames_base == ulc::ParkedStackOptions{}.frames);
+  CHECK(r.jeep->stacked_frames_target == ulc::ParkedStackOptions{}.frames);
   REQUIRE(r.clock);
   CHECK(r.clock->verdict == "parked");
   CHECK_THAT(r.clock->note, Catch::Contains("need not be: the rig stood still"));
   const ulc::io::PairResult j = ulc::io::to_pair_result(r, "lidar64", "lidar32");
   CHECK(j.stages.at("hots").at("stillness").at("still").get<bool>());
   CHECK(j.stages.at("hots").at("status").get<std::string>() == "skipped");
+  CHECK(j.stages.at("jeep").at("stacked_frames_base").get<std::size_t>() ==
+        r.jeep->stacked_frames_base);
 
   SECTION("HOTS alone on it fails and says why") {
     ulc::CalibrateOptions o;

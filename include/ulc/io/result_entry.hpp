@@ -152,6 +152,9 @@ inline Json jeep_to_json(const JeepReport& r) {
   j["reason"] = r.reason;
   j["rounds"] = r.rounds;
   j["frame_pairs"] = r.frame_pairs;
+  j["stacked_frames_base"] = r.stacked_frames_base;
+  j["stacked_frames_target"] = r.stacked_frames_target;
+  j["stack_covariance_scale"] = r.stack_covariance_scale;
   j["initial_T_base_target"] = matrix_to_json(r.initial.matrix());
   j["calibration_status"] = to_string(r.calibration_status);
   j["final_cost"] = r.final_cost;
