@@ -17,7 +17,10 @@
 //     cell jackknife is conservative where few cells pin a direction: on the real croon_0003
 //     frames it gives 3-sigma bounds of 12-160 cm to answers 3.3-4.8 cm off, and judging it
 //     would refuse them; JEEP's results are judged by its acceptance rule and the degenerate
-//     verdict.
+//     verdict. A parked rig's JEEP on stacked frames neither: its scaled covariance is
+//     conservative (median e 0.40), and judged it made 31 of 92 right parked answers uncertain
+//     to catch one 10.65 cm miss (docs/experiments/parked_recordings.md, "Judging the stacks'
+//     covariance").
 //   - The status becomes `uncertain`; the extrinsic and covariance stay for inspection, and the
 //     reason names the loosest direction in the base frame, its sigma and the chance.
 //   - The chance is that of the loosest direction alone: sigma = sqrt of the largest eigenvalue

@@ -25,7 +25,6 @@
 #pragma once
 
 #include <algorithm>
-#include <cmath>
 #include <cstddef>
 #include <unordered_set>
 #include <vector>
@@ -41,15 +40,21 @@ namespace ulc {
 template <class Frames>
 using stacked_cloud_t = PointCloud<traits::scalar_t<odometry::detail::frame_cloud_t<Frames>>>;
 
-/// The finite points of frames[0 .. count) in one cloud, without times.
+/// How many of `frames` to stack: ParkedStackOptions::frames, at least one (0 counts as 1: the
+/// first frame alone) and no more than the recording holds.
+template <class Frames>
+std::size_t frames_to_stack(const Frames& frames, const ParkedStackOptions& o) {
+  return std::min(std::max<std::size_t>(o.frames, 1), static_cast<std::size_t>(frames.size()));
+}
+
+/// The finite points of frames[0 .. count) in one cloud, without times (count <= frames.size()).
 template <class Frames>
 stacked_cloud_t<Frames> stack_frames(const Frames& frames, std::size_t count) {
   stacked_cloud_t<Frames> stack;
-  const std::size_t n = std::min(count, static_cast<std::size_t>(frames.size()));
   std::size_t total = 0;
-  for (std::size_t f = 0; f < n; ++f) total += traits::size(frames[f]);
+  for (std::size_t f = 0; f < count; ++f) total += traits::size(frames[f]);
   stack.points.reserve(total);
-  for (std::size_t f = 0; f < n; ++f) {
+  for (std::size_t f = 0; f < count; ++f) {
     const auto& cloud = frames[f];
     for (std::size_t i = 0; i < traits::size(cloud); ++i) {
       const auto p = traits::point(cloud, i);
@@ -69,7 +74,7 @@ std::unordered_set<VoxelKey, VoxelKeyHash> occupied_cells(const Cloud& cloud, do
 }
 
 /// Frames per occupied cell of frames[0 .. count) stacked, on average (1 for one frame; 0 for
-/// no points).
+/// no points; count <= frames.size()).
 template <class Frames>
 double views_per_cell(const Frames& frames, std::size_t count, double cell) {
   std::unordered_set<VoxelKey, VoxelKeyHash> all;
@@ -101,8 +106,8 @@ ParkedStack<FramesA, FramesB> parked_stack(const FramesA& frames_a,
                                            const FramesB& frames_b, const ParkedStackOptions& o,
                                            double cell) {
   ParkedStack<FramesA, FramesB> s;
-  s.frames_a = std::min(o.frames, static_cast<std::size_t>(frames_a.size()));
-  s.frames_b = std::min(o.frames, static_cast<std::size_t>(frames_b.size()));
+  s.frames_a = frames_to_stack(frames_a, o);
+  s.frames_b = frames_to_stack(frames_b, o);
   s.a.push_back(stack_frames(frames_a, s.frames_a));
   s.b.push_back(stack_frames(frames_b, s.frames_b));
   s.views_a = views_per_cell(frames_a, s.frames_a, cell);

@@ -31,7 +31,7 @@ struct StillnessOptions {
 
 /// What a rig found still gives JEEP (pipeline/parked_stack.hpp).
 struct ParkedStackOptions {
-  /// Frames per LiDAR stacked into JEEP's one frame pair (1: the first frame alone).
+  /// Frames per LiDAR stacked into JEEP's one frame pair (1, or 0: the first frame alone).
   std::size_t frames = 10;
 };
 

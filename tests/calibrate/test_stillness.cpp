@@ -152,6 +152,12 @@ TEST_CASE("a parked rig's stack holds its first frames' finite points, on the ba
 
   const auto all = ulc::parked_stack(a.frames, a.times, b.frames, ulc::ParkedStackOptions{50}, 0.4);
   CHECK(all.frames_a == a.frames.size());  // no more than the recording has
+
+  const auto none = ulc::parked_stack(a.frames, a.times, b.frames, ulc::ParkedStackOptions{0}, 0.4);
+  CHECK(none.frames_a == 1);  // 0 frames asked: the first frame alone, never an empty stack
+  REQUIRE(none.a.size() == 1);
+  CHECK(none.a[0].size() == a.frames[0].size());
+  CHECK(none.covariance_scale() == Approx(1.0));
 }
 
 TEST_CASE("frames that fill new cells are each cell's only view", "[calibrate][stillness]") {
