@@ -91,6 +91,15 @@ std::string free_space_note(const ulc::PairCalibration& r) {
   return s.str();
 }
 
+/// ", two-way gap 1.2 cm / 0.031 deg" when JEEP met both directions halfway (jeep/two_way.hpp).
+std::string two_way_note(const ulc::PairCalibration& r) {
+  if (!r.jeep || !r.jeep->two_way) return "";
+  std::ostringstream s;
+  s << ", two-way gap " << 100.0 * r.jeep->two_way_gap_translation << " cm / "
+    << r.jeep->two_way_gap_rotation * 180.0 / 3.14159265358979 << " deg";
+  return s.str();
+}
+
 Outcome calibrate(const ulc::sim::Dataset& d, const ulc::sim::PairTruth& truth, const Config& c) {
   const auto* a = d.find(truth.base);
   const auto* b = d.find(truth.target);
@@ -120,7 +129,7 @@ Outcome calibrate(const ulc::sim::Dataset& d, const ulc::sim::PairTruth& truth, 
                                                            .eigenvalues()
                                                            .maxCoeff())
                                    : -1.0)
-              << " cm" << free_space_note(r) << "\n";
+              << " cm" << free_space_note(r) << two_way_note(r) << "\n";
   return out;
 }
 

@@ -21,6 +21,15 @@
 //     conservative (median e 0.40), and judged it made 31 of 92 right parked answers uncertain
 //     to catch one 10.65 cm miss (docs/experiments/parked_recordings.md, "Judging the stacks'
 //     covariance").
+//   - JEEP's own successes (HOTS skipped or not asked for) are judged by its two directions
+//     instead (jeep/two_way.hpp): the target's map registered to the base's planes and the base's
+//     to the target's are two fits of the same data, and when they end farther apart than a
+//     success's bars (10 cm, 1 deg) the data do not pin the extrinsic to that promise; the
+//     answer is their midpoint, and the reason gives the gap. On the parked census (single frames,
+//     seeds 1-10 and 21-30, and 2 s stacks, seeds 1-3: 527 successes) it catches colorful seed
+//     1's Mid-40 (10.09 cm off, the directions 19.6 cm apart) and refuses 10 right answers, 0.7-
+//     7.8 cm off (median 5.2; 0.5-0.6 over each census): answers the data pin loosely. Two misses
+//     pass it (4.6 and 3.9 cm apart). docs/experiments/two_way_gap_verdict.md.
 //   - The status becomes `uncertain`; the extrinsic and covariance stay for inspection, and the
 //     reason names the loosest direction in the base frame, its sigma and the chance.
 //   - The chance is that of the loosest direction alone: sigma = sqrt of the largest eigenvalue
@@ -105,6 +114,25 @@ inline std::string loosely_pinned(const PairCalibration& r, const VouchOptions& 
          loose.words + ", above the " + percent(v.max_beyond_probability) +
          " a success allows: the data pins that direction loosely (a longer drive, or one with "
          "turns and structure across it, pins it down)";
+}
+
+/// Why JEEP's two directions disagree too much to vouch for its answer (empty when they agree,
+/// or the answer is HOTS's, which its covariance judges). See the header comment.
+inline std::string directions_disagree(const PairCalibration& r, const VouchOptions& v) {
+  const bool jeeps_answer = r.jeep && !(r.hots && r.hots->run == HotsRun::refined);
+  if (!r.success || !jeeps_answer || !r.jeep->two_way || !v.enabled || !v.judge_two_way_gap)
+    return "";
+  const double gap_m = r.jeep->two_way_gap_translation;
+  const double gap_deg = r.jeep->two_way_gap_rotation * kDegPerRad;
+  if (!(gap_m > v.success_translation_m) && !(gap_deg > v.success_rotation_deg)) return "";
+  char buffer[256];
+  std::snprintf(buffer, sizeof buffer,
+                "JEEP's two directions (the target's points on the base's planes, the base's on "
+                "the target's) end %.1f cm and %.2f deg apart, more than the %.0f cm or %.0f deg a "
+                "success allows: the data do not pin the extrinsic that closely",
+                100.0 * gap_m, gap_deg, 100.0 * v.success_translation_m, v.success_rotation_deg);
+  return std::string(buffer) +
+         " (a few seconds of a parked rig, or a drive with HOTS, pin it down)";
 }
 
 }  // namespace calibrate_detail

@@ -219,6 +219,8 @@ StageOutcome vouch(const AttemptInputs<FA, FB>& in, PairCalibration& r) {
             false};
   if (std::string why = loosely_pinned(r, v); !why.empty())
     return {CalibrateStatus::uncertain, std::move(why), false};
+  if (std::string why = directions_disagree(r, v); !why.empty())
+    return {CalibrateStatus::uncertain, std::move(why), false};
   return kept;
 }
 

@@ -44,6 +44,9 @@ struct VouchOptions {
   double success_translation_m = kCalibrationMaxTranslationM;
   double success_rotation_deg = kCalibrationMaxRotationDeg;
   double max_beyond_probability = 0.05;
+  /// A success that is JEEP's answer becomes `uncertain` when its two directions (jeep/two_way.hpp)
+  /// end farther apart than a success's own bars (pipeline/confidence.hpp).
+  bool judge_two_way_gap = true;
   bool enabled = true;  ///< false: no check (the result still says the offset was not estimated)
 };
 

@@ -1,5 +1,6 @@
 // A success whose own covariance does not vouch for it (pipeline/confidence.hpp): its 3-sigma
-// bound beyond 10 cm or 1 deg along some direction is named, with the direction.
+// bound beyond 10 cm or 1 deg along some direction is named, with the direction; and JEEP's answer
+// whose two directions end farther apart than those bars.
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -66,4 +67,51 @@ TEST_CASE("failures, results without a covariance and JEEP's answers are not jud
   auto jeeps = success_with_covariance(c);  // JEEP's cell jackknife is not judged
   jeeps.hots.reset();
   CHECK(ulc::calibrate_detail::loosely_pinned(jeeps, {}).empty());
+}
+
+namespace {
+
+/// JEEP's success (HOTS skipped) whose two directions ended `gap_m` and `gap_deg` apart.
+ulc::PairCalibration jeeps_success(double gap_m, double gap_deg) {
+  ulc::PairCalibration r;
+  r.success = true;
+  r.status = ulc::CalibrateStatus::ok;
+  r.jeep.emplace();
+  r.jeep->two_way = true;
+  r.jeep->two_way_gap_translation = gap_m;
+  r.jeep->two_way_gap_rotation = gap_deg * kRadiansPerDegree;
+  return r;
+}
+
+}  // namespace
+
+TEST_CASE("JEEP's answer whose two directions disagree beyond a success's bars is named",
+          "[calibrate][confidence]") {
+  using ulc::calibrate_detail::directions_disagree;
+  CHECK(directions_disagree(jeeps_success(0.099, 0.99), {}).empty());
+  const std::string far = directions_disagree(jeeps_success(0.196, 0.32), {});
+  INFO(far);
+  CHECK(mentions(far, "end 19.6 cm and 0.32 deg apart, more than the 10 cm or 1 deg"));
+  CHECK_FALSE(directions_disagree(jeeps_success(0.02, 1.5), {}).empty());  // the rotation alone
+}
+
+TEST_CASE("the two-way gap is judged only on JEEP's own successes, and can be turned off",
+          "[calibrate][confidence]") {
+  using ulc::calibrate_detail::directions_disagree;
+  auto hots = jeeps_success(0.3, 2.0);  // HOTS refined the answer: its covariance judges it
+  hots.hots.emplace();
+  CHECK(directions_disagree(hots, {}).empty());
+  auto failed = jeeps_success(0.3, 2.0);
+  failed.success = false;
+  CHECK(directions_disagree(failed, {}).empty());
+  auto one_way = jeeps_success(0.3, 2.0);  // the backward registration did not end usable
+  one_way.jeep->two_way = false;
+  CHECK(directions_disagree(one_way, {}).empty());
+  ulc::VouchOptions off;
+  off.judge_two_way_gap = false;
+  CHECK(directions_disagree(jeeps_success(0.3, 2.0), off).empty());
+  auto skipped = jeeps_success(0.3, 2.0);  // HOTS skipped itself: JEEP's answer stands
+  skipped.hots.emplace();
+  skipped.hots->run = ulc::HotsRun::skipped;
+  CHECK_FALSE(directions_disagree(skipped, {}).empty());
 }
