@@ -25,11 +25,12 @@
 //     instead (jeep/two_way.hpp): the target's map registered to the base's planes and the base's
 //     to the target's are two fits of the same data, and when they end farther apart than a
 //     success's bars (10 cm, 1 deg) the data do not pin the extrinsic to that promise; the
-//     answer is their midpoint, and the reason gives the gap. On the parked census (single frames,
-//     seeds 1-10 and 21-30, and 2 s stacks, seeds 1-3: 527 successes) it catches colorful seed
-//     1's Mid-40 (10.09 cm off, the directions 19.6 cm apart) and refuses 10 right answers, 0.7-
-//     7.8 cm off (median 5.2; 0.5-0.6 over each census): answers the data pin loosely. Two misses
-//     pass it (4.6 and 3.9 cm apart). docs/experiments/two_way_gap_verdict.md.
+//     answer is their midpoint, and the reason gives the gap. On the parked censuses (single
+//     frames, seeds 1-30, and 2 s stacks, seeds 1-3: 725 successes before it) it catches
+//     colorful seed 1's Mid-40 (10.09 cm off, its directions 19.6 cm apart) and refuses 12 of
+//     722 right answers, 0.7-8.3 cm off (median 5.4; 0.5-0.6 over each census): answers the
+//     data pin loosely. Two misses pass it (4.6 and 3.9 cm apart).
+//     docs/experiments/two_way_gap_verdict.md.
 //   - The status becomes `uncertain`; the extrinsic and covariance stay for inspection, and the
 //     reason names the loosest direction in the base frame, its sigma and the chance.
 //   - The chance is that of the loosest direction alone: sigma = sqrt of the largest eigenvalue
