@@ -37,6 +37,7 @@
 
 #include "pipeline/calibrate.hpp"
 #include "support/bench_util.hpp"
+#include "ulc/core/angles.hpp"
 #include "ulc/core/lie.hpp"
 #include "ulc/core/mahalanobis.hpp"
 #include "ulc/core/pose_error.hpp"
@@ -96,7 +97,7 @@ std::string two_way_note(const ulc::PairCalibration& r) {
   if (!r.jeep || !r.jeep->two_way) return "";
   std::ostringstream s;
   s << ", two-way gap " << 100.0 * r.jeep->two_way_gap_translation << " cm / "
-    << r.jeep->two_way_gap_rotation * 180.0 / 3.14159265358979 << " deg";
+    << r.jeep->two_way_gap_rotation * ulc::kDegPerRad << " deg";
   return s.str();
 }
 
