@@ -135,8 +135,8 @@ void bench(const Config& c) {
       const auto& lidar = d.lidars[t.lidar];
       const ulc::Isometry3d truth = base.T_vehicle_lidar.inverse() * lidar.T_vehicle_lidar;
       const ulc::PoseError e = ulc::pose_error(truth, t.result.T_base_target);
-      const bool hots_ran = t.result.hots && t.result.hots->run == ulc::HotsRun::refined &&
-                            t.result.hots->status == hots::RefineStatus::ok;
+      const bool hots_ran =
+          t.result.hots_refined() && t.result.hots->status == hots::RefineStatus::ok;
       // t_base = t_target + offset; each LiDAR's own clock is t_true - clock_offset.
       const double true_offset = lidar.clock_offset_s - base.clock_offset_s;
       const bool bar = t.ok() && e.rotation_deg < 0.1 && e.translation_m < 0.02;

@@ -102,8 +102,7 @@ inline LooseClaim loose_claim(const Mat3d& block, double bar, double to_unit, co
 
 /// Why the covariance does not vouch for a success (empty when it does, or is not judged).
 inline std::string loosely_pinned(const PairCalibration& r, const VouchOptions& v) {
-  const bool hots_answer = r.hots && r.hots->run == HotsRun::refined;
-  if (!r.success || !hots_answer || !r.covariance_6x6 || !v.enabled) return "";
+  if (!r.success || !r.hots_refined() || !r.covariance_6x6 || !v.enabled) return "";
   const Mat6d& c = *r.covariance_6x6;
   const LooseClaim t = loose_claim(c.topLeftCorner<3, 3>(), v.success_translation_m * 100.0, 100.0,
                                    "cm", "along", 0);
@@ -120,8 +119,8 @@ inline std::string loosely_pinned(const PairCalibration& r, const VouchOptions& 
 /// Why JEEP's two directions disagree too much to vouch for its answer (empty when they agree,
 /// or the answer is HOTS's, which its covariance judges). See the header comment.
 inline std::string directions_disagree(const PairCalibration& r, const VouchOptions& v) {
-  const bool jeeps_answer = r.jeep && !(r.hots && r.hots->run == HotsRun::refined);
-  if (!r.success || !jeeps_answer || !r.jeep->two_way || !v.enabled || !v.judge_two_way_gap)
+  if (!r.success || !r.jeep || r.hots_refined() || !r.jeep->two_way || !v.enabled ||
+      !v.judge_two_way_gap)
     return "";
   const double gap_m = r.jeep->two_way_gap_translation;
   const double gap_deg = r.jeep->two_way_gap_rotation * kDegPerRad;
@@ -132,8 +131,7 @@ inline std::string directions_disagree(const PairCalibration& r, const VouchOpti
                 "the target's) end %.1f cm and %.2f deg apart, more than the %.0f cm or %.0f deg a "
                 "success allows: the data do not pin the extrinsic that closely",
                 100.0 * gap_m, gap_deg, 100.0 * v.success_translation_m, v.success_rotation_deg);
-  return std::string(buffer) +
-         " (a few seconds of a parked rig, or a drive with HOTS, pin it down)";
+  return std::string(buffer) + " (more frames, or a drive for HOTS, pin it down)";
 }
 
 }  // namespace calibrate_detail

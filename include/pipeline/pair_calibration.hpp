@@ -324,6 +324,8 @@ struct PairCalibration {
   BaseWork base_work;
 
   bool ok() const { return success; }
+  /// HOTS refined the extrinsic, so the answer is HOTS's (however its refinement ended).
+  bool hots_refined() const { return hots && hots->run == HotsRun::refined; }
 };
 
 }  // namespace ulc

@@ -160,7 +160,7 @@ ClockReport unestimated_clock(const AttemptInputs<FA, FB>& in, const PairCalibra
 template <class FA, class FB>
 ClockReport clock_report(const AttemptInputs<FA, FB>& in, const PairCalibration& r) {
   ClockReport c;
-  const bool hots_answer = r.hots && r.hots->run == HotsRun::refined;
+  const bool hots_answer = r.hots_refined();
   if (in.options.time_offset_s) {
     c.source = ClockSource::given;
     c.note = "the clock offset was given (" + fixed(*in.options.time_offset_s, 4) + " s)";
@@ -209,7 +209,7 @@ StageOutcome vouch(const AttemptInputs<FA, FB>& in, PairCalibration& r) {
         undeskewed_sweep(which, *report, odometry::frame_period(*times), r, v, in.parked());
     if (!why.empty()) return {CalibrateStatus::point_times_missing, why, false};
   }
-  if (!r.jeep && !(r.hots && r.hots->run == HotsRun::refined)) return kept;  // TERRA's rotation
+  if (!r.jeep && !r.hots_refined()) return kept;  // TERRA's rotation
   r.clock = clock_report(in, r);
   if (r.clock->verdict == "lag_exceeds_bar" || r.clock->verdict == "lag_unobservable")
     return {CalibrateStatus::time_offset_unestimated,
