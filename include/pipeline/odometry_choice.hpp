@@ -25,7 +25,8 @@
 //     failed), the stages after TERRA run again on the joint odometry and that result is the
 //     call's: every drive the joint odometry calibrates is still calibrated (64-tele,
 //     60 s: the base's odometry gave the right answer but a covariance of 6.1 cm along y,
-//     uncertain; the joint one 2.9 cm, ok). The refusals cost both runs.
+//     uncertain; the joint one 2.9 cm, ok). The refusals cost both runs. A static rig
+//     (parked, or too few frames for HOTS) runs no odometry: its stages run once.
 //   - `why` says, in one sentence, which was chosen and why; the result file reports both
 //     (stages.hots.odometry, odometry_choice).
 #pragma once

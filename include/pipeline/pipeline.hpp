@@ -244,12 +244,14 @@ PairCalibration attempts_vouched(const AttemptInputs<FA, FB>& in, const StartRot
 
 /// attempts_vouched on the odometry in.odometry chose; when the automatic choice's base
 /// odometry ends without a success, the stages run again on the joint odometry, whose result is
-/// then the call's, the one the joint odometry alone gives (odometry_choice.hpp).
+/// then the call's, the one the joint odometry alone gives (odometry_choice.hpp). A static rig
+/// (parked, or too few frames for HOTS) runs no odometry, so a second run would repeat the first.
 template <class FA, class FB>
 PairCalibration attempts_on_chosen_odometry(const AttemptInputs<FA, FB>& in,
                                             const StartRotations* starts, PairCalibration& r,
                                             const Finish& finish) {
-  if (!in.odometry.joint_if_refused) return attempts_vouched(in, starts, r, finish);
+  if (!in.odometry.joint_if_refused || in.static_rig())
+    return attempts_vouched(in, starts, r, finish);
   const PairCalibration before = r;
   PairCalibration result = attempts_vouched(in, starts, r, finish);
   if (result.success) return result;

@@ -3,6 +3,7 @@
 // corridor cannot show a move along it, so its frames are not judged still either way. In the
 // pipeline: a parked rig recorded for seconds is calibrated as a snapshot (HOTS skipped, the
 // result says why) without a known clock offset, and a moving drive is judged moving.
+#include <atomic>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <limits>
@@ -200,6 +201,21 @@ TEST_CASE("a parked rig recorded for seconds is calibrated without a clock offse
   CHECK(j.stages.at("hots").at("status").get<std::string>() == "skipped");
   CHECK(j.stages.at("jeep").at("stacked_frames_base").get<std::size_t>() ==
         r.jeep->stacked_frames_base);
+
+  SECTION("a refusal on the base's odometry is not run again on the joint one: none ran") {
+    ulc::CalibrateOptions o;
+    o.tuning.odometry_choice.min_duration_s = 1.0;  // the automatic choice takes the base's
+    o.tuning.vouch.success_translation_m = 1e-6;    // any two-way gap refuses the answer
+    std::atomic<int> jeep_runs{0};
+    o.progress = [&](const std::string& stage, double fraction) {
+      if (stage == "jeep" && fraction == 0.0) ++jeep_runs;
+    };
+    const ulc::PairCalibration u =
+        ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, o);
+    INFO(ulc::to_string(u.status) << ": " << u.reason);
+    CHECK(u.status == ulc::CalibrateStatus::uncertain);
+    CHECK(jeep_runs == 1);
+  }
 
   SECTION("HOTS alone on it fails and says why") {
     ulc::CalibrateOptions o;
