@@ -93,25 +93,27 @@ TEST_CASE("rosbag2 sqlite: flipped bytes are read or an IoError", "[rosbag2][rob
   CHECK(errors > 0);
 }
 
+/// Opening `path` must fail with an IoError naming it and saying `words`.
+inline void check_open_error(const std::filesystem::path& path, const std::string& words) {
+  try {
+    const Rosbag2Sqlite bag(path);
+    FAIL("opened " << path);
+  } catch (const ulc::io::IoError& e) {
+    CHECK(e.file() == path.string());
+    CHECK_THAT(e.what(), Catch::Contains(words));
+  }
+}
+
 TEST_CASE("rosbag2 sqlite: files that are not bags", "[rosbag2][robustness]") {
   rosbag2_test::TempDir dir("not_bags");
-  const auto check_error = [](const std::filesystem::path& path, const std::string& words) {
-    try {
-      Rosbag2Sqlite bag(path);
-      FAIL("opened " << path);
-    } catch (const ulc::io::IoError& e) {
-      CHECK(e.file() == path.string());
-      CHECK_THAT(e.what(), Catch::Contains(words));
-    }
-  };
   save(dir.path() / "empty.db3", std::string());
-  check_error(dir.path() / "empty.db3", "0 bytes");
+  check_open_error(dir.path() / "empty.db3", "0 bytes");
   save(dir.path() / "text.db3", "rosbag2_bagfile_information:\n  version: 4\n");
-  check_error(dir.path() / "text.db3", "not a SQLite database");
+  check_open_error(dir.path() / "text.db3", "not a SQLite database");
   save(dir.path() / "short.db3", std::string("SQLite format 3\0abc", 19));
-  check_error(dir.path() / "short.db3", "truncated");
-  check_error(dir.path() / "missing.db3", "no such file");
-  check_error(dir.path(), "folder");
+  check_open_error(dir.path() / "short.db3", "truncated");
+  check_open_error(dir.path() / "missing.db3", "no such file");
+  check_open_error(dir.path(), "folder");
   // A SQLite database without rosbag2's tables.
   {
     sqlite3* db = nullptr;
@@ -119,7 +121,56 @@ TEST_CASE("rosbag2 sqlite: files that are not bags", "[rosbag2][robustness]") {
     REQUIRE(sqlite3_exec(db, "CREATE TABLE t(x)", nullptr, nullptr, nullptr) == SQLITE_OK);
     sqlite3_close(db);
   }
-  check_error(dir.path() / "other.db3", "no such table");
+  check_open_error(dir.path() / "other.db3", "no such table");
+}
+
+/// A .db3 file built from `sql`: its own topics table (no primary key, so ids may repeat or be
+/// anything), rosbag2's messages table, and one message on topic id 1.
+inline std::filesystem::path hand_made_bag(const rosbag2_test::TempDir& dir,
+                                           const std::string& name, const std::string& topic_rows) {
+  const auto path = dir.path() / name;
+  sqlite3* db = nullptr;
+  REQUIRE(sqlite3_open(path.string().c_str(), &db) == SQLITE_OK);
+  const std::string sql =
+      "CREATE TABLE topics(id, name TEXT, type TEXT, serialization_format TEXT);"
+      "CREATE TABLE messages(id INTEGER PRIMARY KEY, topic_id INTEGER, timestamp INTEGER, "
+      "data BLOB);"
+      "INSERT INTO messages VALUES (1, 1, 100, x'00');" +
+      topic_rows;
+  const int rc = sqlite3_exec(db, sql.c_str(), nullptr, nullptr, nullptr);
+  sqlite3_close(db);
+  REQUIRE(rc == SQLITE_OK);
+  return path;
+}
+
+TEST_CASE("rosbag2 sqlite: a topic id listed twice or not an integer is an IoError",
+          "[rosbag2][robustness]") {
+  rosbag2_test::TempDir dir("topic_ids");
+  // Two names on one id: a cursor on the first would hand out messages as the second's.
+  check_open_error(
+      hand_made_bag(dir, "two_names.db3",
+                    "INSERT INTO topics VALUES (1, '/a', 'std_msgs/msg/String', 'cdr');"
+                    "INSERT INTO topics VALUES (1, '/b', 'std_msgs/msg/String', 'cdr');"),
+      "topic id 1 is listed twice");
+  check_open_error(
+      hand_made_bag(dir, "same_row_twice.db3",
+                    "INSERT INTO topics VALUES (1, '/a', 'std_msgs/msg/String', 'cdr');"
+                    "INSERT INTO topics VALUES (1, '/a', 'std_msgs/msg/String', 'cdr');"),
+      "topic id 1 is listed twice");
+  int file = 0;
+  for (const std::string id : {"1.5", "'1'", "NULL", "x'01'"})
+    check_open_error(hand_made_bag(dir, "id_" + std::to_string(file++) + ".db3",
+                                   "INSERT INTO topics VALUES (" + id +
+                                       ", '/a', 'std_msgs/msg/String', 'cdr');"),
+                     "not an integer");
+  // The same table with distinct integer ids reads.
+  const Rosbag2Sqlite good(
+      hand_made_bag(dir, "good.db3",
+                    "INSERT INTO topics VALUES (1, '/a', 'std_msgs/msg/String', 'cdr');"
+                    "INSERT INTO topics VALUES (2, '/b', 'std_msgs/msg/String', 'cdr');"));
+  REQUIRE(good.topics().size() == 2);
+  CHECK(rosbag2_test::read_all(good, {0}).size() == 1);
+  CHECK(rosbag2_test::read_all(good, {1}).empty());
 }
 
 /// A bag folder holding one written .db3 file and the given metadata.yaml text.

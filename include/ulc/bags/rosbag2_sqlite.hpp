@@ -97,6 +97,22 @@ inline std::string text_column(sqlite3_stmt* s, int column) {
                      static_cast<std::size_t>(sqlite3_column_bytes(s, column)));
 }
 
+/// What a column of SQLite type `type` (SQLITE_INTEGER, ...) holds, for error messages.
+inline const char* type_name(int type) {
+  switch (type) {
+    case SQLITE_INTEGER:
+      return "an integer";
+    case SQLITE_FLOAT:
+      return "a real number";
+    case SQLITE_TEXT:
+      return "text";
+    case SQLITE_BLOB:
+      return "a blob";
+    default:
+      return "NULL";
+  }
+}
+
 /// "file:<path>?immutable=1" with the URI's reserved characters ('%', '?', '#') escaped.
 inline std::string immutable_uri(const std::string& path) {
   std::string uri = "file:";
@@ -195,14 +211,28 @@ class Rosbag2Sqlite : public MessageSource {
       add_topic_row(statement.get(), by_name);
     if (rc != SQLITE_DONE) throw io::IoError(file_, "", sqlite_detail::message_of(db_.get()));
     for (auto& [name, entry] : by_name) {
-      for (const auto id : entry.second.ids) index_of_id_[id] = topics_.size();
+      for (const auto id : entry.second.ids) index_id(id, topics_.size());
       topics_.push_back(std::move(entry.first));
       rows_.push_back(std::move(entry.second));
     }
   }
 
+  /// Maps topics.id `id` to topic `index`. An id on two rows (which rosbag2's primary key rules
+  /// out, a damaged file does not) would hand one topic's messages out as another's.
+  void index_id(std::int64_t id, std::size_t index) {
+    if (!index_of_id_.emplace(id, index).second)
+      throw io::IoError(file_, "topic id " + std::to_string(id),
+                        "topic id " + std::to_string(id) +
+                            " is listed twice in the topics table (a damaged file)");
+  }
+
   void add_topic_row(sqlite3_stmt* s,
                      std::map<std::string, std::pair<TopicInfo, TopicRows>>& by_name) const {
+    if (sqlite3_column_type(s, 0) != SQLITE_INTEGER)
+      throw io::IoError(file_, "topics table",
+                        std::string("a topic id is ") +
+                            sqlite_detail::type_name(sqlite3_column_type(s, 0)) +
+                            ", not an integer (a damaged file)");
     const std::int64_t id = sqlite3_column_int64(s, 0);
     TopicInfo row;
     row.name = sqlite_detail::text_column(s, 1);
@@ -275,8 +305,9 @@ class Rosbag2Sqlite : public MessageSource {
 /// Steps one prepared statement one row at a time; the view points into SQLite's row buffer.
 class Rosbag2Sqlite::Cursor : public MessageCursor {
  public:
-  Cursor(const Rosbag2Sqlite& bag, const std::string& id_list, TimeWindow window)
-      : bag_(bag), window_(window) {
+  Cursor(const Rosbag2Sqlite& bag, const std::string& id_list, std::vector<bool> selected,
+         TimeWindow window)
+      : bag_(bag), selected_(std::move(selected)), window_(window) {
     const bool inline_data = bag.sorted_by_index_;
     rows_ = sqlite_detail::prepare(bag.db_.get(), bag.file_, select_sql(id_list, inline_data));
     sqlite3_bind_int64(rows_.get(), 1, window.begin_ns);
@@ -297,6 +328,7 @@ class Rosbag2Sqlite::Cursor : public MessageCursor {
     last_id_ = sqlite3_column_int64(rows_.get(), 0);
     const auto topic = bag_.index_of_id_.find(sqlite3_column_int64(rows_.get(), 1));
     if (topic == bag_.index_of_id_.end()) fail("its topic_id is not in the topics table");
+    if (!selected_[topic->second]) fail("its topic_id is not one asked for (a damaged file)");
     out.topic = topic->second;
     out.time_ns = sqlite3_column_int64(rows_.get(), 2);
     check_order(out.time_ns);
@@ -353,6 +385,7 @@ class Rosbag2Sqlite::Cursor : public MessageCursor {
   }
 
   const Rosbag2Sqlite& bag_;
+  std::vector<bool> selected_;  ///< per topic index: asked for
   sqlite_detail::Statement rows_;
   sqlite_detail::Statement blob_;
   std::optional<std::int64_t> last_id_;
@@ -371,6 +404,7 @@ class EmptyCursor : public MessageCursor {
 inline std::unique_ptr<MessageCursor> Rosbag2Sqlite::cursor(
     const std::vector<std::size_t>& selected, TimeWindow window) const {
   std::string id_list;
+  std::vector<bool> wanted(topics_.size(), false);
   for (const std::size_t index : selected) {
     if (index >= topics_.size())
       throw std::out_of_range("Rosbag2Sqlite::cursor: topic index " + std::to_string(index) +
@@ -381,10 +415,11 @@ inline std::unique_ptr<MessageCursor> Rosbag2Sqlite::cursor(
                         "topic " + topics_[index].name + ": serialization format \"" +
                             rows.serialization_format + "\" is not supported (only cdr and ros1)");
     for (const auto id : rows.ids) id_list += (id_list.empty() ? "" : ",") + std::to_string(id);
+    wanted[index] = true;
   }
   if (id_list.empty() || window.begin_ns >= window.end_ns)
     return std::make_unique<sqlite_detail::EmptyCursor>();
-  return std::make_unique<Cursor>(*this, id_list, window);
+  return std::make_unique<Cursor>(*this, id_list, std::move(wanted), window);
 }
 
 }  // namespace ulc::bags
