@@ -124,8 +124,8 @@ TEST_CASE("rosbag2 sqlite: files that are not bags", "[rosbag2][robustness]") {
   check_open_error(dir.path() / "other.db3", "no such table");
 }
 
-/// A .db3 file built from `sql`: its own topics table (no primary key, so ids may repeat or be
-/// anything), rosbag2's messages table, and one message on topic id 1.
+/// A .db3 file made by hand: a topics table without a primary key (so ids may repeat or be
+/// anything) holding `topic_rows`, rosbag2's messages table, and one message on topic id 1.
 inline std::filesystem::path hand_made_bag(const rosbag2_test::TempDir& dir,
                                            const std::string& name, const std::string& topic_rows) {
   const auto path = dir.path() / name;
