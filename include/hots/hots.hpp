@@ -75,7 +75,11 @@
 //     reported, not used: from the truth 87-100 % of them agree on the Tele pairs, from starts
 //     2 m, 3 deg or 2 deg off 0-44 %, but HOTS confirmed by them (64-tele seed 2) has no kept
 //     link to tie the two LiDARs in its graph, and its whole-sequence step left the translation
-//     2.3 m off and free along two directions.
+//     2.3 m off and free along two directions. When fewer links were kept than must agree, the
+//     rule looks again with each link's inlier ratio over b's points within a's reach
+//     (refine_steps.hpp, second_look_within_reach): those links, kept and agreeing, confirm the
+//     extrinsic and go into the graph (64-tele seed 2: 26 of 90, all agreeing from the truth;
+//     docs/experiments/cross_links_within_reach.md).
 //   - Nothing here throws (a throwing progress hook passes through) or prints; results are the
 //     same for any number of threads.
 #pragma once

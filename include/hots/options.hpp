@@ -91,6 +91,12 @@ struct CrossLinkOptions {
   /// A converged registration under min_inlier_ratio counts as a weak link when its inlier
   /// ratio reaches this: reported (CrossLinkStats), not used.
   double weak_inlier_ratio = 0.1;
+  /// When too few links are kept to judge the extrinsic, take a second look: each link's inlier
+  /// ratio over b's points within a's reach (the farthest of a's points from its anchor), which
+  /// a's surfaces could hold at all. A Tele-15 or an Avia sees far beyond a short-range base
+  /// (an OS0-128's 50 m), and its points there say nothing of the extrinsic
+  /// (docs/experiments/cross_links_within_reach.md).
+  bool second_look_within_reach = true;
   double min_sigma = 0.01;                                     ///< m
   double agree_rotation_rad = 1.0 * 3.14159265358979 / 180.0;  ///< see the conventions
   double agree_translation_m = 1.0;

@@ -130,13 +130,15 @@ inline bool confirms(LinkVerdict v) {
 }
 
 /// One cross-link registration as HOTS tried it (cross_links.hpp): its layer, whether it
-/// converged, its inlier ratio and how far it moved from its start. It was kept when it
-/// converged with inlier_ratio >= CrossLinkOptions::min_inlier_ratio, and agreed when it moved
-/// less than the agree bounds.
+/// converged, its inlier ratio (over all of b's points, and over those within a's reach) and
+/// how far it moved from its start. It was kept when it converged with the ratio the links were
+/// judged by >= CrossLinkOptions::min_inlier_ratio, and agreed when it moved less than the
+/// agree bounds.
 struct CrossLinkRecord {
   int layer = 0;
   bool converged = false;
   double inlier_ratio = 0.0, moved_rad = 0.0, moved_m = 0.0;
+  double inlier_ratio_in_reach = 0.0;
 };
 
 struct RefineStatistics {
@@ -148,7 +150,10 @@ struct RefineStatistics {
   std::size_t cross_links_converged = 0, cross_links_weak = 0, cross_links_weak_agreeing = 0;
   double cross_link_inlier_ratio_median = 0.0;
   LinkVerdict link_verdict = LinkVerdict::not_judged;  ///< the trust rule on the cross links
-  std::vector<CrossLinkRecord> cross_link_records;     ///< every registration, in link order
+  /// The links were kept and judged by their inlier ratio within a's reach (the second look of
+  /// refine_steps.hpp); the counts above are then that look's.
+  bool links_judged_within_reach = false;
+  std::vector<CrossLinkRecord> cross_link_records;  ///< every registration, in link order
   std::size_t boundary_factors = 0;  ///< top-layer submap boundaries tied in the graph
   std::size_t boundary_links = 0;    ///< of those, by registering the submaps (the rest: odometry)
   std::size_t boundary_bridges = 0;  ///< boundaries tied by a bridge BA (not in boundary_factors)

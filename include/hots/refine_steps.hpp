@@ -27,6 +27,12 @@ namespace hots {
 
 namespace hots_detail {
 
+/// How many kept links must agree for the trust rule to confirm the extrinsic.
+inline double agreeing_needed(const RefineStatistics& st, const RefineOptions& options) {
+  return std::max(static_cast<double>(options.min_cross_links),
+                  options.min_cross_link_ratio * static_cast<double>(st.cross_links_attempted));
+}
+
 /// The trust rule on the cross links (see the conventions): enough kept links agree, too few
 /// do, or none was kept (too little overlap to judge: HOTS has no evidence for the extrinsic
 /// and refuses it too). No attempt: nothing to judge.
@@ -34,11 +40,36 @@ inline LinkVerdict judge_links(const RefineStatistics& st, const RefineOptions& 
   if (!(options.min_cross_link_ratio > 0.0) || st.cross_links_attempted == 0)
     return LinkVerdict::not_judged;
   if (st.cross_links == 0) return LinkVerdict::too_little_overlap;
-  const double needed =
-      std::max(static_cast<double>(options.min_cross_links),
-               options.min_cross_link_ratio * static_cast<double>(st.cross_links_attempted));
-  return static_cast<double>(st.cross_links_agreeing) >= needed ? LinkVerdict::kept_links_agree
-                                                                : LinkVerdict::kept_links_refute;
+  return static_cast<double>(st.cross_links_agreeing) >= agreeing_needed(st, options)
+             ? LinkVerdict::kept_links_agree
+             : LinkVerdict::kept_links_refute;
+}
+
+/// Whether the links deserve a second look within a's reach (CrossLinkOptions::
+/// second_look_within_reach): they did not confirm the extrinsic, and fewer were kept than
+/// would have to agree, so the plain ratio could not have judged it either way. Links kept
+/// and moving away from their start are a verdict, and keep it.
+inline bool second_look_within_reach(const RefineStatistics& st, const RefineOptions& options) {
+  return options.links.second_look_within_reach && !confirms(st.link_verdict) &&
+         static_cast<double>(st.cross_links) < agreeing_needed(st, options);
+}
+
+/// The kept links and their counts into `st`, then the trust rule's verdict on them.
+template <typename S>
+void judge_selected_links(RefineState<S>& s, const std::vector<LinkRegistration>& registrations,
+                          bool within_reach, const RefineOptions& options, RefineStatistics& st) {
+  CrossLinkStats link_stats;
+  s.links = select_links(registrations, options.links, within_reach, link_stats);
+  st.cross_links = s.links.size();
+  st.cross_links_attempted = link_stats.attempted;
+  st.cross_links_agreeing = link_stats.agreeing;
+  st.cross_links_converged = link_stats.converged;
+  st.cross_links_weak = link_stats.weak;
+  st.cross_links_weak_agreeing = link_stats.weak_agreeing;
+  st.cross_link_inlier_ratio_median = link_stats.inlier_ratio_median;
+  st.cross_link_records = std::move(link_stats.records);
+  st.links_judged_within_reach = within_reach;
+  st.link_verdict = judge_links(st, options);
 }
 
 /// Why the cross links did not confirm the extrinsic. Kept links moving away from their
@@ -84,26 +115,21 @@ void build_hierarchies(RefineState<S>& s, const RefineOptions& options, RefineSt
 }
 
 /// The cross links between the LiDARs (cross_links.hpp); false when too few agree with the
-/// extrinsic (see judge_links). Then each LiDAR's top-layer boundaries registered
+/// extrinsic (see judge_links), after a second look within a's reach when too few were kept to
+/// judge (second_look_within_reach). Then each LiDAR's top-layer boundaries registered
 /// (boundary_links.hpp) (statistics: cross_links).
 /// progress gets the fraction of cross links registered.
 template <typename S>
 bool link_lidars(RefineState<S>& s, double time_offset_s, const RefineOptions& options,
                  RefineStatistics& st, const ulc::StepProgress& progress) {
-  CrossLinkStats link_stats;
-  s.links = cross_links(s.a.hierarchy, s.a.frames, s.a.times, s.a.world, s.b.hierarchy, s.b.frames,
-                        s.b.times, s.b.world, time_offset_s, options.links, &link_stats, progress);
-  st.cross_links = s.links.size();
-  st.cross_links_attempted = link_stats.attempted;
-  st.cross_links_agreeing = link_stats.agreeing;
-  st.cross_links_converged = link_stats.converged;
-  st.cross_links_weak = link_stats.weak;
-  st.cross_links_weak_agreeing = link_stats.weak_agreeing;
-  st.cross_link_inlier_ratio_median = link_stats.inlier_ratio_median;
-  st.cross_link_records = std::move(link_stats.records);
+  const std::vector<LinkRegistration> registrations = cross_link_registrations(
+      s.a.hierarchy, s.a.frames, s.a.times, s.a.world, s.b.hierarchy, s.b.frames, s.b.times,
+      s.b.world, time_offset_s, options.links, progress);
   // Decided here, before the graph, the synchronisation and the sequence step: their work
   // would rest on an extrinsic the views refuse (and a caller trying several is spared it).
-  st.link_verdict = judge_links(st, options);
+  judge_selected_links(s, registrations, false, options, st);
+  if (second_look_within_reach(st, options))
+    judge_selected_links(s, registrations, true, options, st);
   if (!confirms(st.link_verdict)) return false;
   if (options.boundary_registration)
     for (RefineLidar<S>* l : {&s.a, &s.b})

@@ -338,10 +338,12 @@ inline void add_refine(HotsReport& h, const hots::RefineResult& r, double second
 inline std::string unconfirmed_hint(const hots::RefineStatistics& st) {
   const std::string attempted = std::to_string(st.cross_links_attempted);
   if (st.link_verdict == hots::LinkVerdict::kept_links_refute)
-    return "; " + std::to_string(st.cross_links_agreeing) + " of " + attempted +
-           " agree: the extrinsic before HOTS is likely wrong (TERRA's rotation or the initial "
-           "guess)";
-  return "; 0 of " + attempted + " registered with enough overlap (" +
+    return "; " + std::to_string(st.cross_links_agreeing) + " of " + attempted + " agree" +
+           (st.links_judged_within_reach ? " (kept by their overlap within the base's reach)"
+                                         : "") +
+           ": the extrinsic before HOTS is likely wrong (TERRA's rotation or the initial guess)";
+  const char* within = st.links_judged_within_reach ? " within the base's reach" : "";
+  return "; 0 of " + attempted + " registered with enough overlap" + within + " (" +
          std::to_string(st.cross_links_converged) + " converged, with a median inlier ratio of " +
          fixed(st.cross_link_inlier_ratio_median, 2) + ", and " +
          std::to_string(st.cross_links_weak_agreeing) + " of the " +

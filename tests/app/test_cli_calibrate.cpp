@@ -297,7 +297,7 @@ TEST_CASE("ulc calibrate --stages hots is accepted and runs odometry and HOTS ov
   CHECK(synced_hots.at("time_sync_pairs").get<double>() == 0);  // the synchronisation never ran
   // Every cross-link registration is in the file, one row each; the counts agree with it.
   const auto& registrations = synced_hots.at("cross_link_registrations");
-  CHECK(registrations.at("columns").size() == 5);
+  CHECK(registrations.at("columns").size() == 6);
   const auto& rows = registrations.at("rows");
   CHECK(rows.size() == synced_hots.at("cross_links_attempted").get<std::size_t>());
   std::size_t converged = 0;

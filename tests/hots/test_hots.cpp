@@ -341,6 +341,88 @@ TEST_CASE("a registration reports its overlap whether or not the link is kept", 
   CHECK(r.kept(options));
 }
 
+TEST_CASE("a registration's overlap within the base's reach leaves out what lies beyond it",
+          "[hots][links]") {
+  // a sees only what lies within 15 m of it; b is the same frame whole, so its points beyond
+  // a's reach can lie on none of a's surfaces whatever the extrinsic.
+  const auto& frame = drive().data.lidars[0].frames.at(0);
+  const std::vector<ulc::Vec3<float>> b(frame.points.begin(), frame.points.end());
+  std::vector<ulc::Vec3<float>> a;
+  for (const auto& p : b)
+    if (p.norm() <= 15.0f) a.push_back(p);
+  const double share_near = static_cast<double>(a.size()) / static_cast<double>(b.size());
+  ulc::Isometry3d start = ulc::Isometry3d::Identity();
+  start.translation() = ulc::Vec3d(0.1, -0.05, 0.0);
+  const hots::CrossLinkOptions options;
+  const auto r =
+      hots::register_link(a, b, start, options, ulc::coarse_to_fine_stages(options.gate));
+  INFO("inlier ratio " << r.inlier_ratio << ", within reach " << r.inlier_ratio_in_reach
+                       << ", b's share within 15 m " << share_near);
+  REQUIRE(r.converged);
+  REQUIRE(share_near < 0.8);
+  CHECK(r.inlier_ratio < share_near + 0.05);
+  CHECK(r.inlier_ratio_in_reach > 0.8);
+  CHECK(r.inlier_ratio_in_reach <= 1.0);
+  hots::CrossLinkOptions strict = options;
+  strict.min_inlier_ratio = 0.5 * (r.inlier_ratio + r.inlier_ratio_in_reach);
+  CHECK_FALSE(r.kept(strict));
+  CHECK(r.kept(strict, true));
+}
+
+TEST_CASE("the links are kept and counted by the ratio they are judged by", "[hots][links]") {
+  const hots::CrossLinkOptions options;  // kept from 0.3, weak from 0.1, agreeing within 1 deg, 1 m
+  const auto registration = [](double ratio, double in_reach, double moved_deg) {
+    hots::LinkRegistration r;
+    r.converged = true;
+    r.inlier_ratio = ratio;
+    r.inlier_ratio_in_reach = in_reach;
+    r.link.moved_rad = moved_deg * hots_test::kDeg;
+    r.link.moved_m = 0.05;
+    return r;
+  };
+  const std::vector<hots::LinkRegistration> registrations = {
+      registration(0.12, 0.50, 0.1), registration(0.35, 0.60, 0.2), registration(0.05, 0.40, 5.0),
+      hots::LinkRegistration{}};
+  hots::CrossLinkStats plain, within;
+  CHECK(hots::select_links(registrations, options, false, plain).size() == 1);
+  CHECK(hots::select_links(registrations, options, true, within).size() == 3);
+  CHECK(plain.attempted == 4);
+  CHECK(plain.converged == 3);
+  CHECK(plain.kept == 1);
+  CHECK(plain.agreeing == 1);
+  CHECK(plain.weak == 1);  // 0.12
+  CHECK(plain.inlier_ratio_median == Approx(0.12));
+  CHECK(within.kept == 3);
+  CHECK(within.agreeing == 2);  // the third moved 5 deg
+  CHECK(within.weak == 0);
+  CHECK(within.inlier_ratio_median == Approx(0.50));
+  REQUIRE(within.records.size() == 4);
+  CHECK(within.records[0].inlier_ratio == 0.12);  // both ratios recorded either way
+  CHECK(within.records[0].inlier_ratio_in_reach == 0.50);
+}
+
+TEST_CASE("the links get a second look within the base's reach only when too few were kept",
+          "[hots][links]") {
+  using hots::LinkVerdict;
+  const hots::RefineOptions options;  // max(3, 3 % of the attempted) agreeing
+  const auto second_look = [](const hots::RefineOptions& o, std::size_t kept,
+                              std::size_t agreeing) {
+    hots::RefineStatistics st;
+    st.cross_links_attempted = 90;
+    st.cross_links = kept;
+    st.cross_links_agreeing = agreeing;
+    st.link_verdict = hots::hots_detail::judge_links(st, o);
+    return hots::hots_detail::second_look_within_reach(st, o);
+  };
+  CHECK(second_look(options, 0, 0));         // none kept
+  CHECK(second_look(options, 2, 2));         // kept, but fewer than the 3 that must agree
+  CHECK_FALSE(second_look(options, 3, 3));   // confirmed
+  CHECK_FALSE(second_look(options, 12, 1));  // kept links moving away: a verdict
+  hots::RefineOptions off = options;
+  off.links.second_look_within_reach = false;
+  CHECK_FALSE(second_look(off, 0, 0));
+}
+
 TEST_CASE("the trust rule: kept links judge; none kept, nothing to judge by", "[hots][links]") {
   using hots::LinkVerdict;
   const hots::RefineOptions options;  // max(3, 3 % of the attempted) agreeing

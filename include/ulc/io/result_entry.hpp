@@ -209,10 +209,11 @@ inline std::string hots_status_text(const HotsReport& h) {
 inline Json cross_link_records_to_json(const std::vector<hots::CrossLinkRecord>& records) {
   Json rows = Json::array();
   for (const auto& r : records)
-    rows.push_back(Json::array(
-        {r.layer, r.converged ? 1 : 0, r.inlier_ratio, r.moved_rad * kDegPerRad, r.moved_m}));
+    rows.push_back(Json::array({r.layer, r.converged ? 1 : 0, r.inlier_ratio,
+                                r.moved_rad * kDegPerRad, r.moved_m, r.inlier_ratio_in_reach}));
   Json j = Json::object();
-  j["columns"] = Json::array({"layer", "converged", "inlier_ratio", "moved_deg", "moved_m"});
+  j["columns"] = Json::array(
+      {"layer", "converged", "inlier_ratio", "moved_deg", "moved_m", "inlier_ratio_in_reach"});
   j["rows"] = std::move(rows);
   return j;
 }
@@ -263,6 +264,7 @@ inline Json hots_to_json(const HotsReport& h) {
   j["cross_links_weak"] = s.cross_links_weak;
   j["cross_links_weak_agreeing"] = s.cross_links_weak_agreeing;
   j["link_verdict"] = hots::to_string(s.link_verdict);
+  j["links_judged_within_reach"] = s.links_judged_within_reach;
   j["cross_link_inlier_ratio_median"] = s.cross_link_inlier_ratio_median;
   j["cross_link_registrations"] = cross_link_records_to_json(s.cross_link_records);
   j["extrinsic_ties"] = s.extrinsic_ties;
