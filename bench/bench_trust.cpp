@@ -57,21 +57,26 @@ struct Start {
 
 /// The cross-link statistics as the default trust rule judges them: the links HOTS kept with
 /// the rule off, and, where the rule would take its second look within a's reach
-/// (hots/refine_steps.hpp), the links that look keeps, recounted from the registrations'
-/// records.
+/// (hots/refine_steps.hpp), the links that look keeps (hots::select_links on the
+/// registrations' records).
 hots::RefineStatistics judged_as_by_default(hots::RefineStatistics st,
                                             const hots::RefineOptions& defaults) {
   namespace hd = hots::hots_detail;
   st.link_verdict = hd::judge_links(st, defaults);
   if (!hd::second_look_within_reach(st, defaults)) return st;
-  const hots::CrossLinkOptions& lo = defaults.links;
-  st.cross_links = st.cross_links_agreeing = 0;
+  std::vector<hots::LinkRegistration> registrations;
   for (const auto& r : st.cross_link_records) {
-    if (!r.converged || r.inlier_ratio_in_reach < lo.min_inlier_ratio) continue;
-    ++st.cross_links;
-    st.cross_links_agreeing +=
-        r.moved_rad < lo.agree_rotation_rad && r.moved_m < lo.agree_translation_m;
+    hots::LinkRegistration reg;
+    reg.converged = r.converged;
+    reg.inlier_ratio = r.inlier_ratio;
+    reg.inlier_ratio_in_reach = r.inlier_ratio_in_reach;
+    reg.link.moved_rad = r.moved_rad;
+    reg.link.moved_m = r.moved_m;
+    registrations.push_back(reg);
   }
+  hots::CrossLinkStats counts;
+  st.cross_links = hots::select_links(registrations, defaults.links, true, counts).size();
+  st.cross_links_agreeing = counts.agreeing;
   st.links_judged_within_reach = true;
   st.link_verdict = hd::judge_links(st, defaults);
   return st;
