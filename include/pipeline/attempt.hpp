@@ -163,10 +163,19 @@ inline bool hots_can_judge(const JeepReport& j) {
 /// single frames of a rig's VLP-16s pin little, and let a twin through (bench_covariance
 /// --parked --parked-seconds 2, seeds 1-3: 3 answers beyond 1 deg / 10 cm in 117 with five
 /// frames: docs/experiments/parked_recordings.md).
+///
+/// On a static rig judged by the free-space check and the two-way verdict, JEEP accepts maps
+/// that agree off the ground at the check's lower overlap (FreeSpaceOptions::
+/// min_off_ground_overlap); free_space_step lets such an answer stand only when both judged it
+/// (unvouched_overlap_refusal).
 template <class FA, class FB>
 jeep::JeepOptions jeep_options(const AttemptInputs<FA, FB>& in) {
   jeep::JeepOptions o = in.options.tuning.jeep;
   if (in.parked()) o.frames = 1;
+  const FreeSpaceOptions& free_space = in.options.tuning.free_space;
+  if (in.static_rig() && free_space.enabled && o.two_way)
+    o.acceptance.min_off_ground_overlap =
+        std::min(o.acceptance.min_off_ground_overlap, free_space.min_off_ground_overlap);
   return o;
 }
 
@@ -260,10 +269,16 @@ std::optional<StageOutcome> free_space_step(const AttemptInputs<FA, FB>& in, Att
   const FreeSpaceOptions& o = in.options.tuning.free_space;
   if (!o.enabled || !at.out.jeep || !at.out.jeep->accepted) return std::nullopt;
   const double gap_s = std::fabs(in.a.times[0] - in.b.times[0]);
-  if (at.out.jeep->target_speed_mps * gap_s > 0.5 * o.voxel) return std::nullopt;
-  const FreeSpaceVerdict v = free_space_verdict(in.a.frames[0], in.b.frames[0], at.extrinsic, o);
-  at.out.jeep->free_space = v;
-  std::string why = free_space_refusal(v, o);
+  std::optional<FreeSpaceVerdict> v;
+  if (at.out.jeep->target_speed_mps * gap_s <= 0.5 * o.voxel) {
+    v = free_space_verdict(in.a.frames[0], in.b.frames[0], at.extrinsic, o);
+    at.out.jeep->free_space = *v;
+  }
+  std::string why = v ? free_space_refusal(*v, o) : std::string();
+  if (why.empty())
+    why = unvouched_overlap_refusal(at.out.jeep->off_ground_overlap,
+                                    in.options.tuning.jeep.acceptance.min_off_ground_overlap, v,
+                                    at.out.jeep->two_way, o);
   if (why.empty()) return std::nullopt;
   return StageOutcome{CalibrateStatus::jeep_failed, std::move(why), true};
 }

@@ -37,6 +37,8 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
+#include <optional>
 #include <string>
 
 #include "pipeline/free_space_options.hpp"
@@ -165,6 +167,8 @@ inline std::string free_space_problem(const FreeSpaceOptions& o) {
   if (std::pow(std::ceil(2.0 * o.range / o.voxel), 3.0) > free_space_detail::kMaxCells)
     return "free space: range / voxel too large (at most 256 voxels along each axis)";
   if (o.stride == 0) return "free space: stride must be at least 1";
+  if (!(o.min_off_ground_overlap >= 0.0 && o.min_off_ground_overlap <= 1.0))
+    return "free space: min_off_ground_overlap must lie in [0, 1]";
   return "";
 }
 
@@ -194,6 +198,34 @@ FreeSpaceVerdict free_space_verdict(const BaseCloud& base, const TargetCloud& ta
     if (state == SeenSpace::kFree && !near) ++v.contradicting;
   }
   return v;
+}
+
+/// An answer JEEP accepted only at the check's lower off-ground overlap (below JEEP's own
+/// `jeep_bound`; FreeSpaceOptions::min_off_ground_overlap) stands only when the checks behind
+/// that bound judged it: the free-space check, on at least min_points of its points and of its
+/// rays (`v`: empty when it could not run, the target having moved between the two frames), and
+/// the two-way verdict, which needs JEEP's backward registration to have succeeded
+/// (`two_way_applied`; a twin whose backward registration failed passed the free-space check at
+/// 20 %: horizon-tele parked, seed 12, docs/experiments/snapshot_acceptance.md). The refusal
+/// in words, or empty.
+inline std::string unvouched_overlap_refusal(double off_ground_overlap, double jeep_bound,
+                                             const std::optional<FreeSpaceVerdict>& v,
+                                             bool two_way_applied, const FreeSpaceOptions& o) {
+  if (off_ground_overlap >= jeep_bound) return "";
+  const bool judged = v && v->judged >= o.min_points && v->rays_judged >= o.min_points;
+  if (judged && two_way_applied) return "";
+  const char* missing = !v ? "the free-space check could not run (the target moved between the "
+                             "two frames)"
+                        : !judged ? "the free-space check judged too few of the target's points "
+                                    "or rays"
+                                  : "JEEP's backward registration failed, so its two directions "
+                                    "could not be compared";
+  char text[400];
+  std::snprintf(text, sizeof text,
+                "JEEP: the maps agree off the ground at %.2f, below %.2f, which a snapshot's "
+                "answer may only with the free-space check and the two-way verdict behind it: %s",
+                off_ground_overlap, jeep_bound, missing);
+  return text;
 }
 
 }  // namespace ulc

@@ -29,6 +29,15 @@ struct FreeSpaceOptions {
   /// the pipeline's 440 right answers 0.000-0.123 (a narrow Tele the highest), flicar-lift seed
   /// 16's accepted Avia twin 0.642.
   double max_through_share = 0.2;
+  /// With the check on, a static snapshot's JEEP accepts maps that agree off the ground at this
+  /// overlap (JEEP's own rule: 0.25, jeep/acceptance.hpp), and such an answer stands only when
+  /// the check judged it (min_points points and rays) and passed it, and JEEP's two-way verdict
+  /// judged it too (unvouched_overlap_refusal, free_space.hpp). Parked corner units agree
+  /// off the ground at 0.155-0.241 at their truth (ring-5x16, seeds 1-10) and were refused by
+  /// JEEP's 0.25, which keeps unrelated streets out (up to 0.34); on a snapshot the wrong answers
+  /// are the scene's look-alikes, which this check, the contest of hypotheses and the two-way
+  /// verdict judge (docs/experiments/snapshot_acceptance.md).
+  double min_off_ground_overlap = 0.15;
 };
 
 /// What the check judged (stages.jeep.free_space).

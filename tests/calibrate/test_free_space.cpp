@@ -4,10 +4,13 @@
 // its rays through the base's walls; the options are checked. In the pipeline: a parked rig's
 // answer carries the verdict, a parked pitched VLP-16 whose JEEP accepted the scene's twin (seed
 // 10) is refused by the base's rays, flicar-lift's Avia twin (seed 16) by the target's own, and
-// a moving rig is not judged.
+// a moving rig is not judged. A parked corner unit whose frame agrees with the base's off the
+// ground below JEEP's own bound stands with the check behind it and is refused without it; such
+// an answer needs the check and the two-way verdict to have judged it.
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -127,6 +130,11 @@ TEST_CASE("the free-space options are checked before any allocation", "[calibrat
   o = {};
   o.stride = 0;
   CHECK_FALSE(ulc::free_space_problem(o).empty());
+  o = {};
+  o.min_off_ground_overlap = std::numeric_limits<double>::quiet_NaN();
+  CHECK_FALSE(ulc::free_space_problem(o).empty());
+  o.min_off_ground_overlap = -0.1;
+  CHECK_FALSE(ulc::free_space_problem(o).empty());
 
   const ulc::sim::Dataset d = parked_snapshot("64-32", 1);
   ulc::CalibrateOptions c;
@@ -201,4 +209,60 @@ TEST_CASE("a parked rig's answer is judged by the free space the base saw",
     REQUIRE(r.jeep);
     CHECK_FALSE(r.jeep->free_space);
   }
+}
+
+TEST_CASE("a parked corner unit stands at a lower off-ground overlap with the check behind it",
+          "[calibrate][free_space]") {
+  // ring-5x16 seed 1's rear-right VLP-16, 2.7 m from the base: at the truth its single frame
+  // agrees with the base's off the ground below JEEP's own 0.25
+  // (docs/experiments/snapshot_acceptance.md).
+  const ulc::sim::Dataset d = parked_snapshot("ring-5x16", 1);
+  const auto* truth = pair_with_target(d, "rear_right");
+  REQUIRE(truth);
+  const auto& a = *d.find(truth->base);
+  const auto& b = *d.find(truth->target);
+  const double jeep_bound = jeep::AcceptanceOptions{}.min_off_ground_overlap;
+
+  const ulc::PairCalibration r =
+      ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, {});
+  const auto e = ulc::pose_error(truth->T_base_target, r.T_base_target);
+  INFO(ulc::to_string(r.status) << ": " << r.reason << " (" << e.rotation_deg << " deg, "
+                                << e.translation_m << " m)");
+  REQUIRE(r.success);
+  CHECK(ulc::is_calibration_success(e));
+  REQUIRE(r.jeep);
+  CHECK(r.jeep->off_ground_overlap < jeep_bound);
+  CHECK(r.jeep->off_ground_overlap >= ulc::FreeSpaceOptions{}.min_off_ground_overlap);
+  REQUIRE(r.jeep->free_space);
+  CHECK(r.jeep->free_space->judged >= ulc::FreeSpaceOptions{}.min_points);
+  CHECK(r.jeep->free_space->rays_judged >= ulc::FreeSpaceOptions{}.min_points);
+
+  // Without the check, JEEP's own rule judges the snapshot and refuses it.
+  ulc::CalibrateOptions unchecked;
+  unchecked.tuning.free_space.enabled = false;
+  const ulc::PairCalibration plain =
+      ulc::calibrate_pair(a.frames, a.timestamps, b.frames, b.timestamps, unchecked);
+  INFO("without the check: " << ulc::to_string(plain.status) << ": " << plain.reason);
+  CHECK_FALSE(plain.success);
+}
+
+TEST_CASE("an answer below JEEP's off-ground bound stands only when both checks judged it",
+          "[calibrate][free_space]") {
+  const ulc::FreeSpaceOptions o;
+  ulc::FreeSpaceVerdict judged;
+  judged.judged = judged.rays_judged = o.min_points;
+  CHECK(ulc::unvouched_overlap_refusal(0.30, 0.25, std::nullopt, false, o).empty());
+  CHECK(ulc::unvouched_overlap_refusal(0.20, 0.25, judged, true, o).empty());
+  const std::string moved = ulc::unvouched_overlap_refusal(0.20, 0.25, std::nullopt, true, o);
+  CHECK(moved.find("0.20, below 0.25") != std::string::npos);
+  CHECK(moved.find("could not run") != std::string::npos);
+  ulc::FreeSpaceVerdict few_rays = judged;
+  few_rays.rays_judged = o.min_points - 1;
+  CHECK(ulc::unvouched_overlap_refusal(0.20, 0.25, few_rays, true, o).find("too few") !=
+        std::string::npos);
+  ulc::FreeSpaceVerdict few_points = judged;
+  few_points.judged = o.min_points - 1;
+  CHECK_FALSE(ulc::unvouched_overlap_refusal(0.20, 0.25, few_points, true, o).empty());
+  CHECK(ulc::unvouched_overlap_refusal(0.20, 0.25, judged, false, o).find("backward") !=
+        std::string::npos);
 }
