@@ -275,10 +275,15 @@ std::optional<StageOutcome> free_space_step(const AttemptInputs<FA, FB>& in, Att
     at.out.jeep->free_space = *v;
   }
   std::string why = v ? free_space_refusal(*v, o) : std::string();
-  if (why.empty())
-    why = unvouched_overlap_refusal(at.out.jeep->off_ground_overlap,
-                                    in.options.tuning.jeep.acceptance.min_off_ground_overlap, v,
-                                    at.out.jeep->two_way, o);
+  if (!why.empty()) {
+    // A look-alike's registration says nothing about the scene: its information is not
+    // judged for a free direction (observability_verdict.hpp), so the refusal names the cause.
+    at.out.jeep->observability.reset();
+    return StageOutcome{CalibrateStatus::jeep_failed, std::move(why), true};
+  }
+  why = unvouched_overlap_refusal(at.out.jeep->off_ground_overlap,
+                                  in.options.tuning.jeep.acceptance.min_off_ground_overlap, v,
+                                  at.out.jeep->two_way, o);
   if (why.empty()) return std::nullopt;
   return StageOutcome{CalibrateStatus::jeep_failed, std::move(why), true};
 }

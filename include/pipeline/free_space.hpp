@@ -214,12 +214,12 @@ inline std::string unvouched_overlap_refusal(double off_ground_overlap, double j
   if (off_ground_overlap >= jeep_bound) return "";
   const bool judged = v && v->judged >= o.min_points && v->rays_judged >= o.min_points;
   if (judged && two_way_applied) return "";
-  const char* missing = !v ? "the free-space check could not run (the target moved between the "
-                             "two frames)"
-                        : !judged ? "the free-space check judged too few of the target's points "
-                                    "or rays"
-                                  : "JEEP's backward registration failed, so its two directions "
-                                    "could not be compared";
+  const char* missing =
+      "JEEP's backward registration failed, so its two directions could not be compared";
+  if (!v)
+    missing = "the free-space check could not run (the target moved between the two frames)";
+  else if (!judged)
+    missing = "the free-space check judged too few of the target's points or rays";
   char text[400];
   std::snprintf(text, sizeof text,
                 "JEEP: the maps agree off the ground at %.2f, below %.2f, which a snapshot's "

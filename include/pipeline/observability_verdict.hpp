@@ -6,8 +6,10 @@
 //     frame against the base's submaps; its normal matrix for C) when it ran, whether HOTS then
 //     succeeded or not; otherwise JEEP's final map-to-map registration (the acceptance's
 //     agreeing points, jeep/acceptance.hpp) when its maps agree, static single frames included;
-//     otherwise none, and nothing is judged (TERRA alone, a failed JEEP whose maps disagree: a
-//     misregistration's information says nothing about the scene).
+//     otherwise none, and nothing is judged (TERRA alone, a failed JEEP whose maps disagree, an
+//     answer the free-space check refused as a look-alike of the scene: a misregistration's
+//     information says nothing about the scene, and a look-alike's own free direction would
+//     name the scene degenerate where the refusal names the true cause).
 //   - When the final problem leaves a direction free, the status is degenerate whatever the
 //     stages said (ok, jeep_failed, hots_failed): the scene is the cause, and on a straight
 //     road or in a tunnel HOTS's time synchronisation fails or its result drifts along the

@@ -161,8 +161,9 @@ struct JeepReport {
   /// (CalibrateOptions::tuning.hypotheses.hots_judges_jeep): the pair's status says which won.
   bool judged_by_hots = false;
   /// The final map-to-map registration's observability of the extrinsic (the acceptance's
-  /// agreeing points, ulc/core/observability.hpp), when the maps agree (else nothing: the
-  /// information of a misregistration says nothing about the scene).
+  /// agreeing points, ulc/core/observability.hpp), when the maps agree and the free-space check
+  /// did not refuse the answer as a look-alike (else nothing: the information of a
+  /// misregistration says nothing about the scene).
   std::optional<Observability> observability;
   double seconds = 0.0;
   /// The target's largest speed over the pairs (a's twists carried to b's origin), m/s: what

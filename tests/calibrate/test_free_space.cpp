@@ -3,8 +3,9 @@
 // target turned or shifted across the street puts its walls where the base saw through and sends
 // its rays through the base's walls; the options are checked. In the pipeline: a parked rig's
 // answer carries the verdict, a parked pitched VLP-16 whose JEEP accepted the scene's twin (seed
-// 10) is refused by the base's rays, flicar-lift's Avia twin (seed 16) by the target's own, and
-// a moving rig is not judged. A parked corner unit whose frame agrees with the base's off the
+// 10) is refused by the base's rays, flicar-lift's Avia twin (seed 16) by the target's own, a
+// refused twin is named as such rather than as a degenerate scene (64-tele seed 3), and a
+// moving rig is not judged. A parked corner unit whose frame agrees with the base's off the
 // ground below JEEP's own bound stands with the check behind it and is refused without it; such
 // an answer needs the check and the two-way verdict to have judged it.
 #include <catch2/catch.hpp>
@@ -197,6 +198,22 @@ TEST_CASE("a parked rig's answer is judged by the free space the base saw",
         a.frames[0], b.frames[0], truth->T_base_target, ulc::FreeSpaceOptions{});
     CHECK(at_truth.rays_judged >= ulc::FreeSpaceOptions{}.min_points);
     CHECK(at_truth.through_share() < 0.05);
+  }
+  SECTION("64-tele seed 3: the Tele's twin is named a look-alike, not a degenerate scene") {
+    // JEEP accepts the street's forward/backward twin (179 deg off); its narrow single frame
+    // leaves a direction of that registration free, but the refusal is the check's.
+    const ulc::sim::Dataset d = parked_snapshot("64-tele", 3);
+    REQUIRE(d.pairs.size() == 1);
+    const ulc::PairCalibration r = calibrate_first_pair(d);
+    const auto e = ulc::pose_error(d.pairs[0].T_base_target, r.T_base_target);
+    INFO(ulc::to_string(r.status) << ": " << r.reason << " (" << e.rotation_deg << " deg)");
+    CHECK_FALSE((r.success && !ulc::is_calibration_success(e)));
+    CHECK(r.status == ulc::CalibrateStatus::jeep_failed);
+    CHECK(r.reason.find("a look-alike of the scene") != std::string::npos);
+    CHECK(r.observability_problem.empty());
+    CHECK(r.unobservable.empty());
+    REQUIRE(r.jeep);
+    CHECK_FALSE(r.jeep->observability);
   }
   SECTION("a moving rig is not judged by it") {
     const ulc::sim::Dataset& d = drive_64_32_hots();
