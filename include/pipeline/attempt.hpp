@@ -268,22 +268,20 @@ template <class FA, class FB>
 std::optional<StageOutcome> free_space_step(const AttemptInputs<FA, FB>& in, Attempt& at) {
   const FreeSpaceOptions& o = in.options.tuning.free_space;
   if (!o.enabled || !at.out.jeep || !at.out.jeep->accepted) return std::nullopt;
+  JeepReport& report = *at.out.jeep;
   const double gap_s = std::fabs(in.a.times[0] - in.b.times[0]);
-  std::optional<FreeSpaceVerdict> v;
-  if (at.out.jeep->target_speed_mps * gap_s <= 0.5 * o.voxel) {
-    v = free_space_verdict(in.a.frames[0], in.b.frames[0], at.extrinsic, o);
-    at.out.jeep->free_space = *v;
-  }
-  std::string why = v ? free_space_refusal(*v, o) : std::string();
+  if (report.target_speed_mps * gap_s <= 0.5 * o.voxel)
+    report.free_space = free_space_verdict(in.a.frames[0], in.b.frames[0], at.extrinsic, o);
+  std::string why = report.free_space ? free_space_refusal(*report.free_space, o) : std::string();
   if (!why.empty()) {
     // A look-alike's registration says nothing about the scene: its information is not
     // judged for a free direction (observability_verdict.hpp), so the refusal names the cause.
-    at.out.jeep->observability.reset();
+    report.observability.reset();
     return StageOutcome{CalibrateStatus::jeep_failed, std::move(why), true};
   }
-  why = unvouched_overlap_refusal(at.out.jeep->off_ground_overlap,
-                                  in.options.tuning.jeep.acceptance.min_off_ground_overlap, v,
-                                  at.out.jeep->two_way, o);
+  why = unvouched_overlap_refusal(report.off_ground_overlap,
+                                  in.options.tuning.jeep.acceptance.min_off_ground_overlap,
+                                  report.free_space, report.two_way, o);
   if (why.empty()) return std::nullopt;
   return StageOutcome{CalibrateStatus::jeep_failed, std::move(why), true};
 }
